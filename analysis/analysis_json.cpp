@@ -1,0 +1,97 @@
+#include "analysis/analysis_json.hpp"
+
+#include <cmath>
+
+namespace sailshape {
+namespace {
+
+nlohmann::json vec(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+// JSON has no NaN: a value that could not be measured is null.
+nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+nlohmann::json sectionParametersToJson(const SectionParameters& p) {
+  return {{"chord_m", num(p.chord_m)},         {"camber_pct", num(p.camber_pct)}, {"draft_pct", num(p.draft_pct)},
+          {"twist_deg", num(p.twist_deg)},     {"twist_rel_deg", num(p.twist_rel_deg)},
+          {"entry_deg", num(p.entry_deg)},     {"exit_deg", num(p.exit_deg)}};
+}
+
+nlohmann::json sectionToJson(const Section& s) {
+  nlohmann::json j = sectionParametersToJson(s.value);
+  j["fraction"] = s.fraction;
+  j["luff_point"] = vec(s.luff_point);
+  j["leech_point"] = vec(s.leech_point);
+  j["uncertainty"] = sectionParametersToJson(s.uncertainty);
+  j["max_camber_point"] = vec(s.max_camber_point);
+  j["plane_normal"] = vec(s.plane_normal);
+  j["plane_tilt_deg"] = s.plane_tilt_deg;
+  j["converged"] = s.converged;
+  nlohmann::json curve = nlohmann::json::array();
+  for (const Vec3& p : s.curve) curve.push_back(vec(p));
+  j["curve"] = std::move(curve);
+  return j;
+}
+
+nlohmann::json analysisToJson(const SailAnalysis& a) {
+  nlohmann::json j;
+  const SailOutline& o = a.outline;
+  nlohmann::json corners = {{"tack", vec(o.tack)}, {"clew", vec(o.clew)}, {"head", vec(o.head)}};
+  if (o.has_peak) corners["peak"] = vec(o.peak);
+  j["sail"] = {{"corners", corners},
+               {"tack", vec(o.tack)},
+               {"clew", vec(o.clew)},
+               {"head", vec(o.head)},
+               {"luff_length_m", o.luff_length_m},
+               {"leech_length_m", o.leech_length_m},
+               {"foot_length_m", o.foot_length_m},
+               {"area_m2", o.area_m2},
+               {"corner_count", o.has_peak ? 4 : 3}};
+  if (o.has_peak) {
+    j["sail"]["peak"] = vec(o.peak);
+    j["sail"]["top_length_m"] = o.top_length_m;
+  }
+  nlohmann::json sections = nlohmann::json::array();
+  for (const Section& s : a.sections.sections) sections.push_back(sectionToJson(s));
+  j["sections"] = std::move(sections);
+  const LuffCurve& l = a.luff;
+  j["luff"] = {{"luff_chord_m", l.luff_chord_m},
+               {"lufa_sag_m", l.lufa_sag_m},
+               {"lufa_sag_pct", l.lufa_sag_pct},
+               {"lufa_position_pct", l.lufa_position_pct},
+               {"lusw_sag_m", l.lusw_sag_m},
+               {"lusw_sag_pct", l.lusw_sag_pct},
+               {"lusw_position_pct", l.lusw_position_pct}};
+  nlohmann::json stages = nlohmann::json::array();
+  for (const StageReport& s : a.stages)
+    stages.push_back({{"name", s.name},
+                      {"points_in", s.points_in},
+                      {"points_out", s.points_out},
+                      {"seconds", s.seconds},
+                      {"warnings", s.warnings}});
+  nlohmann::json clusters = nlohmann::json::array();
+  for (const ClusterInfo& c : a.clusters)
+    clusters.push_back({{"points", c.points},
+                        {"extent_m", c.extent_m},
+                        {"plane_rms_m", c.plane_rms_m},
+                        {"tilt_from_vertical_deg", c.tilt_from_vertical_deg},
+                        {"sail_like", c.sail_like},
+                        {"reason", c.reason}});
+  const Smoothing& sm = a.smoothing_stats;
+  j["diagnostics"] = {{"points_in", a.points_in},
+                      {"sail_points", a.sail_points},
+                      {"mesh_vertices", a.mesh.vertices.size()},
+                      {"mesh_triangles", a.mesh.triangles.size()},
+                      {"stages", stages},
+                      {"clusters", clusters},
+                      {"smoothing", {{"good", sm.good},
+                                     {"fair", sm.fair},
+                                     {"bad", sm.bad},
+                                     {"rms_displacement_m", sm.rms_displacement_m},
+                                     {"max_displacement_m", sm.max_displacement_m}}},
+                      {"warnings", a.warnings}};
+  return j;
+}
+
+}  // namespace sailshape

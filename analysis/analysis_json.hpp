@@ -1,0 +1,13 @@
+#pragma once
+// The JSON document of `sailshape analyze --json` (keys carry units: _m, _deg, _pct).
+#include <nlohmann/json.hpp>
+
+#include "analysis/pipeline.hpp"
+
+namespace sailshape {
+
+nlohmann::json sectionParametersToJson(const SectionParameters& p);
+nlohmann::json sectionToJson(const Section& s);
+nlohmann::json analysisToJson(const SailAnalysis& analysis);
+
+}  // namespace sailshape

@@ -1,0 +1,20 @@
+#pragma once
+// Luff curve measures (SPEC §5): the luff polyline seen in the plane of tack,
+// head and clew (LUFA) and in the plane through tack and head perpendicular to
+// it (LUSW, the luff's vertical "camber", important for spinnakers).
+#include "analysis/sail_outline.hpp"
+
+namespace sailshape {
+
+struct LuffCurve {
+  double luff_chord_m = 0;        // straight tack → head distance
+  // Largest offset of the luff from the tack–head line in each plane, signed:
+  // LUFA positive away from the clew, LUSW positive along (clew−tack)×(head−tack).
+  double lufa_sag_m = 0, lufa_sag_pct = 0, lufa_position_pct = 0;
+  double lusw_sag_m = 0, lusw_sag_pct = 0, lusw_position_pct = 0;
+};
+
+// Throws InvalidInput when the outline has no luff.
+LuffCurve measureLuffCurve(const SailOutline& outline);
+
+}  // namespace sailshape

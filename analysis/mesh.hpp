@@ -1,0 +1,24 @@
+#pragma once
+// Triangle meshes in SI units.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "analysis/cloud.hpp"
+
+namespace sailshape {
+
+struct Mesh {
+  std::vector<Vec3> vertices;                     // metres
+  std::vector<std::array<uint32_t, 3>> triangles; // indices into vertices, counter-clockwise
+
+  bool empty() const { return triangles.empty(); }
+};
+
+// Surface area in m².
+double meshArea(const Mesh& mesh);
+
+// Unit normal of triangle t (zero vector for a degenerate triangle).
+Vec3 triangleNormal(const Mesh& mesh, size_t t);
+
+}  // namespace sailshape

@@ -1,0 +1,50 @@
+#pragma once
+// Nearest-neighbour search over a fixed set of points (k-d tree, nanoflann inside).
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "analysis/cloud.hpp"
+#include "analysis/progress.hpp"
+
+namespace sailshape {
+
+class KdTree {
+ public:
+  // Keeps a reference to `points`: they must outlive the tree and not change.
+  explicit KdTree(const std::vector<Vec3>& points);
+  ~KdTree();
+  KdTree(const KdTree&) = delete;
+  KdTree& operator=(const KdTree&) = delete;
+
+  // The k nearest points to q (fewer if the cloud is smaller), closest first;
+  // squared distances in m².
+  void nearest(const Vec3& q, size_t k, std::vector<uint32_t>& indices, std::vector<double>& dist2) const;
+  // Every point within `radius_m` of q, closest first.
+  void withinRadius(const Vec3& q, double radius_m, std::vector<uint32_t>& indices,
+                    std::vector<double>& dist2) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The k nearest neighbours of every point, the point itself first. Row i holds
+// point i's neighbours: index[i*k + j], squared distance dist2[i*k + j] (m²).
+struct NeighbourTable {
+  size_t k = 0;
+  std::vector<uint32_t> index;
+  std::vector<float> dist2;
+
+  size_t size() const { return k == 0 ? 0 : index.size() / k; }
+  const uint32_t* row(size_t i) const { return index.data() + i * k; }
+  const float* rowDist2(size_t i) const { return dist2.data() + i * k; }
+};
+
+// Throws InvalidInput when k < 1 or the cloud has fewer than k points.
+NeighbourTable nearestNeighbours(const std::vector<Vec3>& points, size_t k, const Progress& progress = {});
+
+// Median distance from each point to its nearest other point, m (0 for < 2 points).
+double medianSpacing(const NeighbourTable& table);
+
+}  // namespace sailshape

@@ -1,0 +1,119 @@
+#include "analysis/params_io.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "analysis/errors.hpp"
+
+namespace sailshape {
+
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(NormalParams, k_neighbours, orientation)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegionGrowingParams, k_neighbours, max_normal_angle_deg, max_curvature,
+                                                min_points, max_points)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SailPickParams, method, seed_point, cluster_index, min_depth_m,
+                                                min_depth_ratio, min_extent_m, max_tilt_deg)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StatisticalOutlierParams, k_neighbours, std_ratio)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RadiusOutlierParams, radius_m, min_neighbours)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SmoothingParams, k_neighbours, polynomial_order, good_m, fair_m)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SurfaceParams, projection, max_edge_m, max_edge_factor,
+                                                largest_component_only)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(OutlineParams, corners, corner_window_m, min_fourth_corner_deg,
+                                                edge_smoothing_m, design_lengths_m, design_tolerance)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions, plane, end_window, peak_window,
+                                                normal_tolerance_deg, max_tilt_deg, max_iterations, normal_radius,
+                                                curve_points)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, normals, segment, region_growing,
+                                                sail_pick, statistical_outliers, statistical, radius_outliers, radius,
+                                                smooth, smoothing, surface, outline, sections)
+
+namespace {
+
+// Every key of `doc` must exist in `reference` (the defaults), recursively.
+void checkKeys(const nlohmann::json& doc, const nlohmann::json& reference, const std::string& prefix) {
+  if (!doc.is_object()) return;
+  for (auto it = doc.begin(); it != doc.end(); ++it) {
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (!reference.contains(it.key())) throw InvalidInput("[paramsFromJson] unknown parameter '" + key + "'");
+    if (reference[it.key()].is_object()) {
+      if (!it.value().is_object()) throw InvalidInput("[paramsFromJson] parameter '" + key + "' must be an object");
+      checkKeys(it.value(), reference[it.key()], key);
+    }
+  }
+}
+
+nlohmann::json yamlToJson(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Map: {
+      nlohmann::json j = nlohmann::json::object();
+      for (const auto& kv : node) j[kv.first.as<std::string>()] = yamlToJson(kv.second);
+      return j;
+    }
+    case YAML::NodeType::Sequence: {
+      nlohmann::json j = nlohmann::json::array();
+      for (const auto& v : node) j.push_back(yamlToJson(v));
+      return j;
+    }
+    case YAML::NodeType::Scalar: {
+      const std::string s = node.Scalar();
+      if (node.Tag() == "!") return s;  // quoted
+      if (s == "true" || s == "True") return true;
+      if (s == "false" || s == "False") return false;
+      try {
+        size_t used = 0;
+        const long long i = std::stoll(s, &used);
+        if (used == s.size()) return i;
+      } catch (...) {
+      }
+      try {
+        size_t used = 0;
+        const double d = std::stod(s, &used);
+        if (used == s.size()) return d;
+      } catch (...) {
+      }
+      return s;
+    }
+    default:
+      return nullptr;
+  }
+}
+
+}  // namespace
+
+nlohmann::json paramsToJson(const AnalysisParams& params) { return params; }
+
+AnalysisParams paramsFromJson(const nlohmann::json& doc) {
+  if (!doc.is_object()) throw InvalidInput("[paramsFromJson] the parameter document must be an object");
+  checkKeys(doc, paramsToJson(AnalysisParams{}), "");
+  try {
+    return doc.get<AnalysisParams>();
+  } catch (const nlohmann::json::exception& e) {
+    throw InvalidInput(std::string("[paramsFromJson] ") + e.what());
+  }
+}
+
+AnalysisParams loadParams(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw FileError(path + ": cannot open parameter file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  const bool yaml = path.size() >= 5 && (path.substr(path.size() - 5) == ".yaml" || path.substr(path.size() - 4) == ".yml");
+  nlohmann::json doc;
+  try {
+    doc = yaml ? yamlToJson(YAML::Load(text)) : nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    throw FileError(path + ": " + (yaml ? "YAML" : "JSON") + " parse error: " + e.what());
+  }
+  try {
+    return paramsFromJson(doc);
+  } catch (const InvalidInput& e) {
+    std::string msg = e.what();
+    const std::string tag = "[paramsFromJson] ";
+    if (msg.rfind(tag, 0) == 0) msg = msg.substr(tag.size());
+    throw FileError(path + ": " + msg);
+  }
+}
+
+}  // namespace sailshape

@@ -1,0 +1,110 @@
+#include "analysis/pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "analysis/errors.hpp"
+
+namespace sailshape {
+namespace {
+
+class StageTimer {
+ public:
+  StageTimer(SailAnalysis& a, std::string name, size_t points_in) : analysis_(a) {
+    report_.name = std::move(name);
+    report_.points_in = points_in;
+    start_ = std::chrono::steady_clock::now();
+  }
+  void finish(size_t points_out, const std::vector<std::string>& warnings = {}) {
+    report_.points_out = points_out;
+    report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    report_.warnings = warnings;
+    for (const auto& w : warnings) analysis_.warnings.push_back(report_.name + ": " + w);
+    analysis_.stages.push_back(report_);
+  }
+
+ private:
+  SailAnalysis& analysis_;
+  StageReport report_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
+
+SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
+  if (input.empty()) throw InvalidInput("[analyzeSail] empty cloud");
+  for (size_t i = 0; i < input.size(); ++i)
+    if (!input.points[i].allFinite())
+      throw InvalidInput("[analyzeSail] point " + std::to_string(i) + " has a non-finite coordinate");
+  if (!(p.sensor_sigma_m > 0))
+    throw InvalidInput("[analyzeSail] sensor_sigma_m must be > 0 (got " + std::to_string(p.sensor_sigma_m) + ")");
+  SailAnalysis a;
+  a.points_in = input.size();
+  Cloud cloud = input;
+
+  if (p.segment) {
+    StageTimer t(a, "segmentation", cloud.size());
+    const size_t k = static_cast<size_t>(std::max(p.normals.k_neighbours, p.region_growing.k_neighbours));
+    const NeighbourTable table = nearestNeighbours(cloud.points, k, progress);
+    const NormalEstimation normals = estimateNormals(cloud, table, p.normals, progress);
+    const Segmentation seg = growRegions(cloud, normals.normals, table, p.region_growing, progress);
+    const SailPick pick = pickSailCluster(cloud, seg, p.sail_pick);
+    a.clusters = pick.candidates;
+    std::vector<uint32_t> idx = seg.clusters[pick.cluster];
+    std::sort(idx.begin(), idx.end());
+    cloud = selectPoints(cloud, idx);
+    std::vector<std::string> w = normals.warnings;
+    w.insert(w.end(), seg.warnings.begin(), seg.warnings.end());
+    w.insert(w.end(), pick.warnings.begin(), pick.warnings.end());
+    t.finish(cloud.size(), w);
+  }
+
+  if (p.statistical_outliers) {
+    StageTimer t(a, "statistical outliers", cloud.size());
+    const Cleaning c = removeStatisticalOutliers(cloud, p.statistical, progress);
+    cloud = selectPoints(cloud, c.kept);
+    t.finish(cloud.size(), c.warnings);
+  }
+  if (p.radius_outliers) {
+    StageTimer t(a, "radius outliers", cloud.size());
+    const Cleaning c = removeRadiusOutliers(cloud, p.radius, progress);
+    cloud = selectPoints(cloud, c.kept);
+    t.finish(cloud.size(), c.warnings);
+  }
+  a.sail_points = cloud.size();
+
+  if (p.smooth) {
+    StageTimer t(a, "smoothing", cloud.size());
+    SmoothingParams sp = p.smoothing;
+    Smoothing s = smoothMls(cloud, sp, progress);
+    cloud = std::move(s.cloud);
+    s.cloud = Cloud{};
+    a.smoothing_stats = s;
+    t.finish(cloud.size(), s.warnings);
+  }
+
+  {
+    StageTimer t(a, "surface", cloud.size());
+    Surface s = reconstructSurface(cloud, p.surface, progress);
+    a.mesh = std::move(s.mesh);
+    t.finish(a.mesh.vertices.size(), s.warnings);
+  }
+  {
+    StageTimer t(a, "outline", a.mesh.vertices.size());
+    a.outline = extractOutline(a.mesh, p.outline);
+    a.luff = measureLuffCurve(a.outline);
+    t.finish(a.outline.boundary.size(), a.outline.warnings);
+  }
+  {
+    StageTimer t(a, "sections", a.mesh.vertices.size());
+    SectionParams sp = p.sections;
+    sp.sensor_sigma_m = p.sensor_sigma_m;
+    a.sections = cutSections(a.mesh, a.outline, sp);
+    t.finish(a.sections.sections.size(), a.sections.warnings);
+  }
+  progress("done", 1.0);
+  a.sail_cloud = std::move(cloud);
+  return a;
+}
+
+}  // namespace sailshape

@@ -1,0 +1,63 @@
+#pragma once
+// The whole analysis of one flying-sail cloud (SPEC §4 steps 3–6):
+// normals → segmentation → cleaning → smoothing → surface → outline → sections.
+#include <string>
+#include <vector>
+
+#include "analysis/cleaning.hpp"
+#include "analysis/cloud.hpp"
+#include "analysis/luff_curve.hpp"
+#include "analysis/mesh.hpp"
+#include "analysis/normals.hpp"
+#include "analysis/progress.hpp"
+#include "analysis/sail_outline.hpp"
+#include "analysis/sections.hpp"
+#include "analysis/segmentation.hpp"
+#include "analysis/smoothing.hpp"
+#include "analysis/surface.hpp"
+
+namespace sailshape {
+
+struct AnalysisParams {
+  double sensor_sigma_m = 0.004;   // SPEC §3; feeds smoothing classes and uncertainties
+  NormalParams normals;
+  bool segment = true;             // false: the cloud is the sail alone, skip segmentation
+  RegionGrowingParams region_growing;
+  SailPickParams sail_pick;
+  bool statistical_outliers = true;
+  StatisticalOutlierParams statistical;
+  bool radius_outliers = true;
+  RadiusOutlierParams radius;
+  bool smooth = true;
+  SmoothingParams smoothing;
+  SurfaceParams surface;
+  OutlineParams outline;
+  SectionParams sections;
+};
+
+struct StageReport {
+  std::string name;
+  size_t points_in = 0, points_out = 0;
+  double seconds = 0;
+  std::vector<std::string> warnings;
+};
+
+struct SailAnalysis {
+  size_t points_in = 0;
+  size_t sail_points = 0;            // after segmentation and cleaning
+  Cloud sail_cloud;                  // the smoothed sail points
+  Mesh mesh;
+  SailOutline outline;
+  SectionAnalysis sections;
+  LuffCurve luff;
+  Smoothing smoothing_stats;         // displacement classes (cloud emptied to save memory)
+  std::vector<ClusterInfo> clusters; // what segmentation found
+  std::vector<StageReport> stages;
+  std::vector<std::string> warnings; // every stage's warnings, prefixed by stage
+};
+
+// Throws InvalidInput for an empty cloud or bad parameters, AnalysisError when
+// a stage cannot produce its result (no sail found, no boundary, ...).
+SailAnalysis analyzeSail(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {});
+
+}  // namespace sailshape

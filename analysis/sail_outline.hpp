@@ -1,0 +1,47 @@
+#pragma once
+// The sail's outline on its mesh (SPEC §4 step 6): boundary = edges used by one
+// triangle; corners = the 3 (or 4 for square-top sails) boundary points with the
+// sharpest turning; luff, leech, foot (and top) are the boundary between them.
+#include <string>
+#include <vector>
+
+#include "analysis/cloud.hpp"
+#include "analysis/mesh.hpp"
+
+namespace sailshape {
+
+struct OutlineParams {
+  int corners = 0;                    // 0: auto (3, or 4 when a 4th turns enough), 3 or 4
+  double corner_window_m = 0.0;       // arm length for the turning angle; 0: 2 % of the boundary length
+  double min_fourth_corner_deg = 40;  // auto: a 4th corner needs at least this turning angle
+  double edge_smoothing_m = 0.0;      // moving-average window along the edges; 0: 0.6 % of boundary length
+  // Design lengths [luff, leech, foot] in metres to check against (empty: no check);
+  // more than design_tolerance off stops the analysis (SPEC §4 step 6).
+  std::vector<double> design_lengths_m;
+  double design_tolerance = 0.10;
+};
+
+struct SailOutline {
+  std::vector<Vec3> boundary;         // the outer boundary loop, as found on the mesh
+  Vec3 tack = Vec3::Zero(), clew = Vec3::Zero(), head = Vec3::Zero(), peak = Vec3::Zero();
+  bool has_peak = false;              // square-top sail: head (luff side) and peak (leech side)
+  std::vector<double> corner_turn_deg;  // turning angle at tack, clew, head (, peak)
+  // Edge polylines, smoothed, from corner to corner: luff tack→head, leech
+  // clew→head (clew→peak with a peak), foot tack→clew, top head→peak.
+  std::vector<Vec3> luff, leech, foot, top;
+  double luff_length_m = 0, leech_length_m = 0, foot_length_m = 0, top_length_m = 0;
+  double area_m2 = 0;
+  double boundary_spacing_m = 0;      // median boundary segment length
+  std::vector<std::string> warnings;
+};
+
+// Throws AnalysisError when the mesh has no boundary loop, the corners cannot be
+// told apart, or a length is more than design_tolerance off its design value.
+SailOutline extractOutline(const Mesh& mesh, const OutlineParams& params = {});
+
+// Length of a polyline, m.
+double polylineLength(const std::vector<Vec3>& line);
+// The point at `fraction` (0..1) of a polyline's arc length.
+Vec3 pointAtFraction(const std::vector<Vec3>& line, double fraction);
+
+}  // namespace sailshape

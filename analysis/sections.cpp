@@ -1,0 +1,378 @@
+#include "analysis/sections.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "analysis/errors.hpp"
+
+namespace sailshape {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = 180.0 / kPi;
+
+struct Cut {
+  std::vector<Vec3> points;
+  std::vector<uint32_t> triangles;  // triangle of segment i → i+1
+};
+
+// Intersects the mesh with the plane (point q, unit normal m) and returns the
+// cut polylines, chained through shared mesh edges.
+std::vector<Cut> cutMesh(const Mesh& mesh, const Vec3& q, const Vec3& m) {
+  std::vector<double> d(mesh.vertices.size());
+  for (size_t i = 0; i < d.size(); ++i) {
+    d[i] = m.dot(mesh.vertices[i] - q);
+    if (d[i] == 0) d[i] = 1e-15;  // a vertex on the plane counts as above it
+  }
+  auto edgeKey = [](uint32_t a, uint32_t b) { return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a; };
+  struct Link {
+    uint64_t a = 0, b = 0;  // the two crossed edges of a cut triangle
+    uint32_t tri = 0;
+  };
+  std::vector<Link> links;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> by_edge;  // edge → links using it
+  std::unordered_map<uint64_t, Vec3> edge_point;
+  for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    uint64_t crossed[2];
+    int c = 0;
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = tri[e], b = tri[(e + 1) % 3];
+      if ((d[a] > 0) == (d[b] > 0)) continue;
+      const uint64_t k = edgeKey(a, b);
+      if (!edge_point.count(k)) {
+        const double s = d[a] / (d[a] - d[b]);
+        edge_point[k] = mesh.vertices[a] + s * (mesh.vertices[b] - mesh.vertices[a]);
+      }
+      if (c < 2) crossed[c++] = k;
+    }
+    if (c != 2) continue;
+    by_edge[crossed[0]].push_back(static_cast<uint32_t>(links.size()));
+    by_edge[crossed[1]].push_back(static_cast<uint32_t>(links.size()));
+    links.push_back({crossed[0], crossed[1], t});
+  }
+  std::vector<char> used(links.size(), 0);
+  std::vector<Cut> cuts;
+  auto walk = [&](uint32_t start_link, uint64_t start_edge) {
+    Cut cut;
+    cut.points.push_back(edge_point[start_edge]);
+    uint32_t link = start_link;
+    uint64_t edge = start_edge;
+    while (true) {
+      used[link] = 1;
+      const uint64_t other = links[link].a == edge ? links[link].b : links[link].a;
+      cut.points.push_back(edge_point[other]);
+      cut.triangles.push_back(links[link].tri);
+      edge = other;
+      uint32_t next = std::numeric_limits<uint32_t>::max();
+      for (uint32_t l : by_edge[edge])
+        if (!used[l]) next = l;
+      if (next == std::numeric_limits<uint32_t>::max()) break;
+      link = next;
+    }
+    cuts.push_back(std::move(cut));
+  };
+  // Open polylines first (they start at an edge with one link), then loops.
+  for (uint32_t l = 0; l < links.size(); ++l) {
+    if (used[l]) continue;
+    if (by_edge[links[l].a].size() == 1) walk(l, links[l].a);
+    else if (by_edge[links[l].b].size() == 1) walk(l, links[l].b);
+  }
+  for (uint32_t l = 0; l < links.size(); ++l)
+    if (!used[l]) walk(l, links[l].a);
+  return cuts;
+}
+
+// The cut that runs from near the luff point to near the leech point, oriented luff → leech.
+bool pickCut(std::vector<Cut>& cuts, const Vec3& L, const Vec3& R, double chord, Cut& out) {
+  double best = std::numeric_limits<double>::infinity();
+  int best_i = -1;
+  for (size_t i = 0; i < cuts.size(); ++i) {
+    double dl = std::numeric_limits<double>::infinity(), dr = dl;
+    for (const Vec3& p : cuts[i].points) {
+      dl = std::min(dl, (p - L).norm());
+      dr = std::min(dr, (p - R).norm());
+    }
+    if (dl + dr < best) {
+      best = dl + dr;
+      best_i = static_cast<int>(i);
+    }
+  }
+  if (best_i < 0 || best > 0.2 * chord) return false;
+  out = std::move(cuts[static_cast<size_t>(best_i)]);
+  if ((out.points.front() - L).norm() > (out.points.back() - L).norm()) {
+    std::reverse(out.points.begin(), out.points.end());
+    std::reverse(out.triangles.begin(), out.triangles.end());
+  }
+  return true;
+}
+
+struct QuadFit {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();  // y = c0 + c1 u + c2 u², u = x - x0
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  bool ok = false;
+};
+
+// Least-squares quadratic with the coefficients' covariance; `floor_sigma`
+// bounds the residual σ from below (a perfect fit still has sensor noise).
+QuadFit fitQuadratic(const std::vector<Eigen::Vector2d>& xy, double x0, double floor_sigma) {
+  QuadFit f;
+  if (xy.size() < 4) return f;
+  Eigen::MatrixXd A(xy.size(), 3);
+  Eigen::VectorXd y(xy.size());
+  for (size_t i = 0; i < xy.size(); ++i) {
+    const double u = xy[i].x() - x0;
+    A.row(static_cast<Eigen::Index>(i)) << 1, u, u * u;
+    y[static_cast<Eigen::Index>(i)] = xy[i].y();
+  }
+  const Eigen::Matrix3d AtA = A.transpose() * A;
+  Eigen::FullPivLU<Eigen::Matrix3d> lu(AtA);
+  if (!lu.isInvertible()) return f;
+  f.c = lu.solve(A.transpose() * y);
+  const double rss = (A * f.c - y).squaredNorm();
+  const double s2 = std::max(rss / static_cast<double>(xy.size() - 3), floor_sigma * floor_sigma);
+  f.cov = s2 * lu.inverse();
+  f.ok = true;
+  return f;
+}
+
+struct Frame {
+  Vec3 L, R, c_hat, y_hat, m;  // luff, leech, chord direction, in-plane normal to chord, plane normal
+  double chord;
+};
+
+std::vector<Eigen::Vector2d> toChordCoords(const Cut& cut, const Frame& f) {
+  std::vector<Eigen::Vector2d> xy;
+  xy.reserve(cut.points.size());
+  for (const Vec3& p : cut.points) xy.emplace_back((p - f.L).dot(f.c_hat), (p - f.L).dot(f.y_hat));
+  return xy;
+}
+
+size_t maxDepthIndex(const std::vector<Eigen::Vector2d>& xy, double chord) {
+  size_t best = 0;
+  double best_y = -1;
+  for (size_t i = 0; i < xy.size(); ++i)
+    if (xy[i].x() >= 0 && xy[i].x() <= chord && std::abs(xy[i].y()) > best_y) {
+      best_y = std::abs(xy[i].y());
+      best = i;
+    }
+  return best;
+}
+
+// Area-weighted mean normal of the triangles within `radius` of p.
+Vec3 surfaceNormalNear(const Mesh& mesh, const Vec3& p, double radius, uint32_t fallback_tri) {
+  Vec3 sum = Vec3::Zero();
+  const double r2 = radius * radius;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    const Vec3 centre = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0;
+    if ((centre - p).squaredNorm() > r2) continue;
+    sum += (mesh.vertices[tri[1]] - mesh.vertices[tri[0]]).cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
+  }
+  if (sum.norm() == 0) return triangleNormal(mesh, fallback_tri);
+  return sum.normalized();
+}
+
+std::vector<Vec3> resampleCurve(const std::vector<Vec3>& line, int n) {
+  std::vector<Vec3> out;
+  if (n < 2 || line.size() < 2) return line;
+  out.reserve(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) out.push_back(pointAtFraction(line, static_cast<double>(i) / (n - 1)));
+  return out;
+}
+
+}  // namespace
+
+double twistDeg(const Vec3& luff_point, const Vec3& leech_point) {
+  const Vec3 d = luff_point - leech_point;
+  return std::atan2(std::abs(d.y()), d.x()) * kDeg;
+}
+
+std::vector<double> sectionFractions(const SectionParams& p) {
+  std::vector<double> f = p.fractions;
+  if (f.empty()) {
+    if (p.count < 1 || p.count > 100)
+      throw InvalidInput("[cutSections] count must be in [1, 100] (got " + std::to_string(p.count) + ")");
+    for (int k = 1; k <= p.count; ++k) f.push_back(static_cast<double>(k) / (p.count + 1));
+  }
+  for (double t : f)
+    if (!(t > 0 && t < 1))
+      throw InvalidInput("[cutSections] section fractions must be in (0, 1) (got " + std::to_string(t) + ")");
+  std::sort(f.begin(), f.end());
+  return f;
+}
+
+SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const SectionParams& p) {
+  if (mesh.empty()) throw InvalidInput("[cutSections] empty mesh");
+  if (p.plane != "normal" && p.plane != "perpendicular" && p.plane != "horizontal")
+    throw InvalidInput("[cutSections] plane must be normal, perpendicular or horizontal (got '" + p.plane + "')");
+  if (!(p.end_window > 0 && p.end_window <= 0.5))
+    throw InvalidInput("[cutSections] end_window must be in (0, 0.5] (got " + std::to_string(p.end_window) + ")");
+  if (!(p.peak_window > 0 && p.peak_window <= 0.5))
+    throw InvalidInput("[cutSections] peak_window must be in (0, 0.5] (got " + std::to_string(p.peak_window) + ")");
+  if (outline.luff.size() < 2 || outline.leech.size() < 2)
+    throw InvalidInput("[cutSections] outline has no luff or leech");
+  const std::vector<double> fractions = sectionFractions(p);
+
+  // Plane of the corners: its normal starts every section plane.
+  const Vec3 top = outline.has_peak ? 0.5 * (outline.head + outline.peak) : outline.head;
+  Vec3 corner_normal = (outline.clew - outline.tack).cross(top - outline.tack);
+  if (corner_normal.norm() == 0) throw AnalysisError("[cutSections] the corners are collinear");
+  corner_normal.normalize();
+  const double spacing = outline.boundary_spacing_m;
+  const double sigma_pt = std::sqrt(p.sensor_sigma_m * p.sensor_sigma_m + spacing * spacing / 12.0);
+
+  SectionAnalysis result;
+  for (double t : fractions) {
+    Section s;
+    s.fraction = t;
+    Frame f;
+    f.L = pointAtFraction(outline.luff, t);
+    if (p.plane == "horizontal") {
+      // The leech point is where the leech crosses the luff point's height.
+      bool found = false;
+      for (size_t i = 1; i < outline.leech.size() && !found; ++i) {
+        const Vec3 &a = outline.leech[i - 1], &b = outline.leech[i];
+        if ((a.z() - f.L.z()) * (b.z() - f.L.z()) <= 0 && a.z() != b.z()) {
+          f.R = a + (f.L.z() - a.z()) / (b.z() - a.z()) * (b - a);
+          found = true;
+        }
+      }
+      if (!found)
+        throw AnalysisError("[cutSections] horizontal plane at z = " + std::to_string(f.L.z()) +
+                            " m does not cross the leech");
+    } else {
+      f.R = pointAtFraction(outline.leech, t);
+    }
+    f.chord = (f.R - f.L).norm();
+    if (f.chord <= 0) throw AnalysisError("[cutSections] zero chord at fraction " + std::to_string(t));
+    f.c_hat = (f.R - f.L) / f.chord;
+    Vec3 m0 = p.plane == "horizontal" ? Vec3::UnitZ() : f.c_hat.cross(corner_normal);
+    if (m0.norm() < 1e-9) m0 = f.c_hat.cross(Vec3::UnitZ());
+    m0.normalize();
+    const Vec3 e0 = f.c_hat.cross(m0);
+
+    double phi = 0;
+    Cut cut;
+    auto cutAt = [&](double angle) {
+      f.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
+      f.y_hat = f.m.cross(f.c_hat);
+      auto cuts = cutMesh(mesh, f.L, f.m);
+      if (!pickCut(cuts, f.L, f.R, f.chord, cut))
+        throw AnalysisError("[cutSections] the section plane at fraction " + std::to_string(t) +
+                            " does not cut the sail between luff and leech");
+    };
+    cutAt(0);
+    s.converged = true;
+    if (p.plane == "normal") {
+      s.converged = false;
+      for (int it = 0; it < p.max_iterations; ++it) {
+        const auto xy = toChordCoords(cut, f);
+        const size_t imax = maxDepthIndex(xy, f.chord);
+        const uint32_t tri = cut.triangles[std::min(imax, cut.triangles.size() - 1)];
+        const Vec3 n = surfaceNormalNear(mesh, cut.points[imax], p.normal_radius * f.chord, tri);
+        const Vec3 e = f.c_hat.cross(f.m);
+        const double out_of_plane = std::asin(std::clamp(f.m.dot(n), -1.0, 1.0)) * kDeg;
+        if (std::abs(out_of_plane) <= p.normal_tolerance_deg) {
+          s.converged = true;
+          break;
+        }
+        const double en = e.dot(n);
+        if (std::abs(en) < 1e-9) break;
+        phi += std::atan(-f.m.dot(n) / en);
+        if (std::abs(phi) * kDeg > p.max_tilt_deg) {
+          phi = std::copysign(p.max_tilt_deg / kDeg, phi);
+          cutAt(phi);
+          break;
+        }
+        cutAt(phi);
+      }
+      if (!s.converged)
+        result.warnings.push_back("section " + std::to_string(t) + ": the plane did not reach the surface normal within " +
+                                  std::to_string(p.normal_tolerance_deg) + " deg");
+    }
+    s.plane_tilt_deg = phi * kDeg;
+    s.plane_normal = f.m;
+    s.luff_point = f.L;
+    s.leech_point = f.R;
+    const auto xy = toChordCoords(cut, f);
+    s.curve_samples = xy.size();
+
+    // Maximum depth: refined by a quadratic through the points around the deepest one.
+    const size_t imax = maxDepthIndex(xy, f.chord);
+    const double side = xy[imax].y() >= 0 ? 1.0 : -1.0;
+    double depth = std::abs(xy[imax].y()), depth_x = xy[imax].x();
+    double sd_depth = p.sensor_sigma_m, sd_x = spacing;
+    {
+      std::vector<Eigen::Vector2d> win;
+      for (const auto& v : xy)
+        if (std::abs(v.x() - depth_x) <= p.peak_window * f.chord) win.emplace_back(v.x(), side * v.y());
+      const QuadFit q = fitQuadratic(win, depth_x, 0.0);
+      if (q.ok && q.c[2] < 0) {
+        const double u = -q.c[1] / (2 * q.c[2]);
+        if (std::abs(u) <= p.peak_window * f.chord) {
+          depth = q.c[0] - q.c[1] * q.c[1] / (4 * q.c[2]);
+          depth_x += u;
+          const Eigen::Vector3d g_depth(1, -q.c[1] / (2 * q.c[2]), q.c[1] * q.c[1] / (4 * q.c[2] * q.c[2]));
+          const Eigen::Vector3d g_x(0, -1 / (2 * q.c[2]), q.c[1] / (2 * q.c[2] * q.c[2]));
+          sd_depth = std::sqrt(std::max(0.0, g_depth.dot(q.cov * g_depth)));
+          sd_x = std::sqrt(std::max(0.0, g_x.dot(q.cov * g_x)));
+        }
+      }
+    }
+    s.max_camber_point = f.L + depth_x * f.c_hat + side * depth * f.y_hat;
+
+    // Entry and exit: quadratic over the first / last end_window of chord, slope at the end.
+    auto endAngle = [&](bool at_luff, double& sd_deg) {
+      std::vector<Eigen::Vector2d> win;
+      const double x_end = at_luff ? 0.0 : f.chord;
+      for (const auto& v : xy)
+        if (std::abs(v.x() - x_end) <= p.end_window * f.chord) win.emplace_back(v.x(), side * v.y());
+      const QuadFit q = fitQuadratic(win, x_end, 0.0);
+      if (!q.ok) {
+        sd_deg = std::numeric_limits<double>::quiet_NaN();
+        result.warnings.push_back("section " + std::to_string(t) + ": too few points for the " +
+                                  (at_luff ? "entry" : "exit") + " angle");
+        return std::numeric_limits<double>::quiet_NaN();
+      }
+      const double slope = at_luff ? q.c[1] : -q.c[1];
+      sd_deg = std::sqrt(q.cov(1, 1)) / (1 + slope * slope) * kDeg;
+      return std::atan(slope) * kDeg;
+    };
+
+    SectionParameters& v = s.value;
+    SectionParameters& u = s.uncertainty;
+    v.chord_m = f.chord;
+    v.camber_pct = 100.0 * depth / f.chord;
+    v.draft_pct = 100.0 * depth_x / f.chord;
+    v.twist_deg = twistDeg(f.L, f.R);
+    v.entry_deg = endAngle(true, u.entry_deg);
+    v.exit_deg = endAngle(false, u.exit_deg);
+    const double chord_dir_sd = std::sqrt(2.0) * sigma_pt / f.chord;  // rad
+    const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
+    u.chord_m = std::sqrt(2.0) * sigma_pt;
+    u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.5 * sigma_pt * sigma_pt) / f.chord;
+    u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_pt * sigma_pt) / f.chord;
+    u.twist_deg = chord_xy > 0 ? std::sqrt(2.0) * sigma_pt / chord_xy * kDeg : 180.0;
+    u.entry_deg = std::hypot(u.entry_deg, chord_dir_sd * kDeg);
+    u.exit_deg = std::hypot(u.exit_deg, chord_dir_sd * kDeg);
+
+    std::vector<Vec3> line = cut.points;
+    s.curve = resampleCurve(line, p.curve_points);
+    result.sections.push_back(std::move(s));
+  }
+  if (!result.sections.empty()) {
+    const Section& low = result.sections.front();
+    for (Section& s : result.sections) {
+      s.value.twist_rel_deg = s.value.twist_deg - low.value.twist_deg;
+      s.uncertainty.twist_rel_deg =
+          &s == &low ? 0.0 : std::hypot(s.uncertainty.twist_deg, low.uncertainty.twist_deg);
+    }
+  }
+  return result;
+}
+
+}  // namespace sailshape

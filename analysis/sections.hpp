@@ -1,0 +1,68 @@
+#pragma once
+// Sections and their shape parameters: the contract of SPEC §5.
+#include <string>
+#include <vector>
+
+#include "analysis/cloud.hpp"
+#include "analysis/mesh.hpp"
+#include "analysis/sail_outline.hpp"
+
+namespace sailshape {
+
+struct SectionParams {
+  int count = 3;                      // t = k/(count+1), k = 1..count
+  std::vector<double> fractions;      // explicit fractions in (0, 1); override count when set
+  // "normal": start perpendicular to the corners' plane, then rotate about the
+  // chord until the plane holds the surface normal at maximum camber;
+  // "perpendicular": the start plane only; "horizontal": z = const through the luff point.
+  std::string plane = "normal";
+  double end_window = 0.10;           // fraction of chord for the entry/exit quadratic fits
+  double peak_window = 0.05;          // ± fraction of chord for the quadratic fit at maximum camber
+  double normal_tolerance_deg = 0.1;  // out-of-plane angle of the surface normal accepted as "contains"
+  double max_tilt_deg = 45.0;         // limit of the rotation about the chord
+  int max_iterations = 20;
+  double normal_radius = 0.05;        // fraction of chord averaged for the surface normal
+  double sensor_sigma_m = 0.004;      // SPEC §3 random error, for the uncertainties
+  int curve_points = 61;              // points of the output curve
+};
+
+// Per-section parameters; also used for their uncertainties (1σ, same units).
+struct SectionParameters {
+  double chord_m = 0;
+  double camber_pct = 0;
+  double draft_pct = 0;
+  double twist_deg = 0;
+  double twist_rel_deg = 0;
+  double entry_deg = 0;
+  double exit_deg = 0;
+};
+
+struct Section {
+  double fraction = 0;
+  Vec3 luff_point = Vec3::Zero(), leech_point = Vec3::Zero();
+  SectionParameters value, uncertainty;
+  Vec3 max_camber_point = Vec3::Zero();
+  Vec3 plane_normal = Vec3::UnitZ();
+  double plane_tilt_deg = 0;          // rotation about the chord from the start plane
+  bool converged = true;              // the normal search met its tolerance
+  std::vector<Vec3> curve;            // boat frame, luff to leech
+  size_t curve_samples = 0;           // cut points the parameters were computed from
+};
+
+struct SectionAnalysis {
+  std::vector<Section> sections;      // ordered by fraction
+  std::vector<std::string> warnings;
+};
+
+// The fractions `params` asks for, validated and sorted.
+std::vector<double> sectionFractions(const SectionParams& params);
+
+// Throws InvalidInput for bad parameters and AnalysisError when a section plane
+// does not cut the mesh between luff and leech.
+SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const SectionParams& params = {});
+
+// Twist per SPEC §5: angle in the XY plane between +X and the chord vector from
+// leech to luff, degrees in [0, 180].
+double twistDeg(const Vec3& luff_point, const Vec3& leech_point);
+
+}  // namespace sailshape

@@ -1,0 +1,33 @@
+#pragma once
+// Moving-least-squares smoothing (SPEC §4 step 4): each point is projected onto
+// a weighted quadratic fitted to its neighbourhood in a local frame. How far
+// each point moved is classed good (< good_m, the sensor σ), fair (< fair_m,
+// σ + systematic error) or bad; the neighbourhood must keep bad points near zero.
+#include <string>
+#include <vector>
+
+#include "analysis/cloud.hpp"
+#include "analysis/progress.hpp"
+
+namespace sailshape {
+
+struct SmoothingParams {
+  int k_neighbours = 60;        // neighbourhood size; its radius is the distance to the k-th neighbour
+  int polynomial_order = 2;     // 1: plane, 2: quadratic
+  double good_m = 0.004;        // sensor random error σ (SPEC §3)
+  double fair_m = 0.009;        // σ + systematic error: 9 mm at model scale, 14 mm full scale
+};
+
+struct Smoothing {
+  Cloud cloud;                        // smoothed points, attributes carried over
+  std::vector<float> displacement_m;  // per point, how far it moved
+  size_t good = 0, fair = 0, bad = 0;
+  double rms_displacement_m = 0;
+  double max_displacement_m = 0;
+  double mean_radius_m = 0;           // mean neighbourhood radius used
+  std::vector<std::string> warnings;
+};
+
+Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& params = {}, const Progress& progress = {});
+
+}  // namespace sailshape

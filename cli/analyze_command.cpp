@@ -1,0 +1,126 @@
+// `sailshape analyze`: the analysis pipeline on one cloud.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include "analysis/analysis_json.hpp"
+#include "analysis/cloud_io.hpp"
+#include "analysis/errors.hpp"
+#include "analysis/mesh_io.hpp"
+#include "analysis/params_io.hpp"
+#include "analysis/pipeline.hpp"
+#include "cli/commands.hpp"
+#include "cli/progress_bar.hpp"
+
+namespace sailshape::cli {
+namespace {
+
+struct AnalyzeOptions {
+  std::string input;
+  int sections = 0;
+  std::vector<double> at;
+  std::string plane;
+  std::string json_out, mesh_out, params_file, cloud_out;
+  bool print_params = false, no_segment = false, quiet = false;
+  int corners = -1;
+};
+
+void printTable(const SailAnalysis& a) {
+  const SailOutline& o = a.outline;
+  std::printf("Sail: %zu of %zu points, %zu triangles, area %.2f m2\n", a.sail_points, a.points_in,
+              a.mesh.triangles.size(), o.area_m2);
+  auto corner = [](const char* name, const Vec3& p) {
+    std::printf("  %-5s (%8.3f, %8.3f, %8.3f) m\n", name, p.x(), p.y(), p.z());
+  };
+  corner("tack", o.tack);
+  corner("clew", o.clew);
+  corner("head", o.head);
+  if (o.has_peak) corner("peak", o.peak);
+  std::printf("  luff %.3f m, leech %.3f m, foot %.3f m", o.luff_length_m, o.leech_length_m, o.foot_length_m);
+  if (o.has_peak) std::printf(", top %.3f m", o.top_length_m);
+  std::printf("\n  luff curve: LUFA sag %.1f mm at %.0f %%, LUSW sag %.1f mm at %.0f %%\n\n", 1000 * a.luff.lufa_sag_m,
+              a.luff.lufa_position_pct, 1000 * a.luff.lusw_sag_m, a.luff.lusw_position_pct);
+  std::printf("%8s %9s %14s %14s %14s %14s %13s %13s\n", "height", "chord m", "camber %", "draft %", "twist deg",
+              "twist rel", "entry deg", "exit deg");
+  for (const Section& s : a.sections.sections) {
+    const SectionParameters &v = s.value, &u = s.uncertainty;
+    std::printf("%7.0f%% %9.3f %6.2f ±%5.2f %6.1f ±%5.1f %6.2f ±%5.2f %6.2f ±%5.2f %5.1f ±%5.1f %5.1f ±%5.1f\n",
+                100 * s.fraction, v.chord_m, v.camber_pct, u.camber_pct, v.draft_pct, u.draft_pct, v.twist_deg,
+                u.twist_deg, v.twist_rel_deg, u.twist_rel_deg, v.entry_deg, u.entry_deg, v.exit_deg, u.exit_deg);
+  }
+  if (!a.warnings.empty()) {
+    std::printf("\nWarnings:\n");
+    for (const auto& w : a.warnings) std::printf("  %s\n", w.c_str());
+  }
+}
+
+void run(const AnalyzeOptions& o) {
+  AnalysisParams params = o.params_file.empty() ? AnalysisParams{} : loadParams(o.params_file);
+  if (o.sections > 0) {
+    params.sections.count = o.sections;
+    params.sections.fractions.clear();
+  }
+  if (!o.at.empty()) params.sections.fractions = o.at;
+  if (!o.plane.empty()) params.sections.plane = o.plane;
+  if (o.no_segment) params.segment = false;
+  if (o.corners >= 0) params.outline.corners = o.corners;
+  if (o.print_params) {
+    std::cout << paramsToJson(params).dump(2) << "\n";
+    return;
+  }
+  if (o.input.empty()) throw InvalidInput("analyze: an INPUT cloud file is required");
+
+  ProgressBar bar(!o.quiet);
+  CloudReadResult read = readCloud(o.input);
+  for (const auto& w : read.warnings) std::fprintf(stderr, "warning: %s: %s\n", o.input.c_str(), w.c_str());
+  SailAnalysis a = analyzeSail(read.cloud, params, bar.progress());
+  bar.finish();
+  if (!o.mesh_out.empty()) writeMesh(o.mesh_out, a.mesh);
+  if (!o.cloud_out.empty()) writeCloud(o.cloud_out, a.sail_cloud);
+  if (!o.json_out.empty()) {
+    nlohmann::json doc = analysisToJson(a);
+    doc["input"] = o.input;
+    doc["parameters"] = paramsToJson(params);
+    std::ofstream out(o.json_out);
+    if (!out) throw FileError(o.json_out + ": cannot open for writing");
+    out << doc.dump(2) << "\n";
+    if (!out) throw FileError(o.json_out + ": write failed");
+    if (!o.quiet) std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());
+  } else {
+    printTable(a);
+  }
+}
+
+}  // namespace
+
+void addAnalyzeCommand(CLI::App& app) {
+  auto opt = std::make_shared<AnalyzeOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "analyze",
+      "Analyse a cloud of a flying sail (alone or in a scene with mast, boom and deck, in the boat frame): "
+      "segment it, clean and smooth it, build its surface, find corners and edges, and cut sections with "
+      "camber, draft, twist, entry and exit angles, each with its uncertainty.");
+  cmd->add_option("INPUT", opt->input, "Cloud file: .ply (ascii/binary), .pcd, .xyz/.txt or .csv, metres");
+  cmd->add_option("--sections", opt->sections, "Number of sections N, at t = k/(N+1) of luff and leech (default 3)")
+      ->check(CLI::Range(1, 100));
+  cmd->add_option("--at", opt->at, "Explicit section fractions, comma separated, e.g. 0.25,0.5,0.75")
+      ->delimiter(',')
+      ->excludes("--sections");
+  cmd->add_option("--plane", opt->plane,
+                  "Section plane: normal (holds the surface normal at maximum camber; default), perpendicular "
+                  "(to the corners' plane) or horizontal (z = const through the luff point)")
+      ->check(CLI::IsMember({"normal", "perpendicular", "horizontal"}));
+  cmd->add_option("--json", opt->json_out, "Write the full result as JSON to this file instead of the table");
+  cmd->add_option("--mesh", opt->mesh_out, "Write the reconstructed sail surface (.ply, .obj or .stl)");
+  cmd->add_option("--sail-cloud", opt->cloud_out, "Write the segmented, cleaned and smoothed sail points");
+  cmd->add_option("--params", opt->params_file, "Pipeline parameters file (.json, .yaml or .yml); see --print-params");
+  cmd->add_option("--corners", opt->corners, "Corners of the sail: 3, 4 (square top) or 0 for automatic")
+      ->check(CLI::IsMember({0, 3, 4}));
+  cmd->add_flag("--no-segment", opt->no_segment, "The input is the sail alone: skip segmentation");
+  cmd->add_flag("--print-params", opt->print_params, "Print every pipeline parameter with its value and exit");
+  cmd->add_flag("-q,--quiet", opt->quiet, "No progress output");
+  cmd->callback([opt] { run(*opt); });
+}
+
+}  // namespace sailshape::cli

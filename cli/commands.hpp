@@ -1,0 +1,11 @@
+#pragma once
+// Subcommands of the `sailshape` command. Each registers its options on the
+// app and runs through a callback; errors propagate as exceptions to main().
+#include <CLI/CLI.hpp>
+
+namespace sailshape::cli {
+
+void addAnalyzeCommand(CLI::App& app);
+void addSimulateCommand(CLI::App& app);
+
+}  // namespace sailshape::cli
