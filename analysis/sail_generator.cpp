@@ -13,6 +13,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRad = kPi / 180.0;
 constexpr int kCurveSamples = 4001;
+constexpr int kRollSamples = 401;
 
 // Monotone cubic (Fritsch–Carlson) through (x[i], y[i]); x strictly increasing.
 double pchip(const std::vector<double>& x, const std::vector<double>& y, double t) {
@@ -216,6 +217,48 @@ SailSurface::SailSurface(const SailDesign& design) : design_(design) {
   }
   luff_ = arcUniform(luff3, kCurveSamples);
   leech_ = arcUniform(leech3, kCurveSamples);
+
+  // Roll each section plane about its chord until it holds the surface normal at
+  // the maximum-camber point; the normal there is ∂S/∂f × chord, since ∂S/∂u is
+  // along the chord where the mean line is flat. A fixed point over all sections.
+  plane_roll_rad_.assign(kRollSamples, 0.0);
+  const double h = 1.0 / (kRollSamples - 1);
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    double largest = 0;
+    std::vector<double> next = plane_roll_rad_;
+    for (int i = 0; i < kRollSamples; ++i) {
+      const double f = i * h;
+      const Vec3 c = leechPoint(f) - luffPoint(f);
+      if (c.norm() < 1e-3) continue;
+      const Vec3 c_hat = c.normalized();
+      const double u = stationAt(f).draft_pct / 100.0;
+      const double f0 = std::max(0.0, f - h), f1 = std::min(1.0, f + h);
+      const Vec3 normal = (at(f1, u) - at(f0, u)).cross(c_hat);
+      const Vec3 m = c_hat.cross(depthDirection(f));
+      const Vec3 e = c_hat.cross(m);
+      const double en = e.dot(normal);
+      if (std::abs(en) < 1e-12) continue;
+      const double delta = std::atan(-m.dot(normal) / en);
+      next[i] += delta;
+      largest = std::max(largest, std::abs(delta));
+    }
+    plane_roll_rad_ = next;
+    if (largest < 1e-9) break;
+  }
+}
+
+Vec3 SailSurface::depthDirection(double f) const {
+  const Vec3 c = leechPoint(f) - luffPoint(f);
+  const double side = design_.leeward_port ? 1.0 : -1.0;
+  Vec3 n0 = c.cross(Vec3::UnitZ());
+  if (n0.norm() < 1e-9 * std::max(1.0, c.norm())) n0 = c.unitOrthogonal();
+  n0 = side * n0.normalized();
+  if (plane_roll_rad_.empty() || c.norm() == 0) return n0;
+  const double x = std::clamp(f, 0.0, 1.0) * (kRollSamples - 1);
+  const size_t i = std::min(static_cast<size_t>(x), static_cast<size_t>(kRollSamples - 2));
+  const double roll = plane_roll_rad_[i] + (x - static_cast<double>(i)) * (plane_roll_rad_[i + 1] - plane_roll_rad_[i]);
+  const Vec3 m0 = c.normalized().cross(n0);
+  return std::cos(roll) * n0 + std::sin(roll) * m0;
 }
 
 Vec3 SailSurface::luffPoint(double f) const { return alongPolyline(luff_, f); }
@@ -246,11 +289,7 @@ Vec3 SailSurface::at(double f, double u) const {
   const Vec3 c = R - L;
   const double len = c.norm();
   if (len < 1e-12) return L;
-  const double side = design_.leeward_port ? 1.0 : -1.0;
-  Vec3 n = c.cross(Vec3::UnitZ());
-  if (n.norm() < 1e-9 * len) n = c.unitOrthogonal();
-  n = side * n.normalized();
-  return L + u * c + len * meanLine(stationAt(f), u) * n;
+  return L + u * c + len * meanLine(stationAt(f), u) * depthDirection(f);
 }
 
 KnownSection SailSurface::section(double f) const {

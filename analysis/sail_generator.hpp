@@ -76,8 +76,13 @@ class SailSurface {
   Vec3 peak() const { return leechPoint(1); }  // equals head for triangular sails
 
  private:
+  Vec3 depthDirection(double f) const;  // unit offset direction of section f's mean line
+
   SailDesign design_;
   std::vector<Vec3> luff_, leech_;  // arc-length uniform polylines, foot → head
+  // Rotation of each section's plane about its chord (on a uniform f grid), so
+  // that the plane holds the surface normal at maximum camber, as SPEC §5 cuts it.
+  std::vector<double> plane_roll_rad_;
 };
 
 // Triangle mesh of the design (rows along f, columns along u; a triangular

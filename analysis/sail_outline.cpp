@@ -7,6 +7,9 @@
 #include <unordered_set>
 
 #include "analysis/errors.hpp"
+#include "analysis/neighbours.hpp"
+
+#include <Eigen/Eigenvalues>
 
 namespace sailshape {
 namespace {
@@ -98,6 +101,100 @@ std::vector<Vec3> smoothPolyline(const std::vector<Vec3>& line, double step, dou
     out[i] = sum / static_cast<double>(2 * h + 1);
   }
   return out;
+}
+
+// Area-weighted vertex normals.
+std::vector<Vec3> vertexNormals(const Mesh& mesh) {
+  std::vector<Vec3> n(mesh.vertices.size(), Vec3::Zero());
+  for (const auto& t : mesh.triangles) {
+    const Vec3 fn = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    for (uint32_t v : t) n[v] += fn;
+  }
+  for (Vec3& v : n)
+    if (v.norm() > 0) v.normalize();
+  return n;
+}
+
+// A sampled surface's boundary lies inside the true edge: the outermost samples
+// sit some distance in. Sample offsets from the true edge are uniform on
+// [0, ∞), so within the strip s ≤ D of the found edge (offset s from it,
+// positive inwards) they are uniform on [−δ, D] and δ = D − 2·mean(s).
+// Returns the edge moved out by δ, and δ.
+std::pair<std::vector<Vec3>, double> pushEdgeOut(const std::vector<Vec3>& edge, const Mesh& mesh,
+                                                 const std::vector<Vec3>& normals, const KdTree& vertex_tree,
+                                                 double spacing) {
+  const double strip = 4.0 * spacing;
+  const size_t n = edge.size();
+  if (n < 5) return {edge, 0.0};
+  std::vector<Vec3> inward(n);
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 t = (edge[std::min(i + 1, n - 1)] - edge[i > 0 ? i - 1 : 0]).normalized();
+    vertex_tree.nearest(edge[i], 8, idx, d2);
+    Vec3 normal = Vec3::Zero();
+    Vec3 centre = Vec3::Zero();
+    for (uint32_t v : idx) {
+      normal += normals[v];
+      centre += mesh.vertices[v];
+    }
+    centre /= static_cast<double>(idx.size());
+    Vec3 in = normal.normalized().cross(t);
+    if (in.dot(centre - edge[i]) < 0) in = -in;  // the vertex cloud lies inwards
+    inward[i] = in;
+  }
+  // Offsets of the vertices near the middle 90 % of the edge (corners excluded).
+  double sum = 0;
+  size_t count = 0;
+  const size_t lo = n / 20, hi = n - 1 - n / 20;
+  for (size_t i = lo; i <= hi; ++i) {
+    vertex_tree.withinRadius(edge[i], strip, idx, d2);
+    for (uint32_t v : idx) {
+      const Vec3 d = mesh.vertices[v] - edge[i];
+      const Vec3 t = (edge[std::min(i + 1, n - 1)] - edge[i > 0 ? i - 1 : 0]).normalized();
+      const double along = d.dot(t);
+      if (std::abs(along) > 0.5 * (edge[std::min(i + 1, n - 1)] - edge[i]).norm()) continue;  // nearest sample only
+      const double s = d.dot(inward[i]);
+      if (s > strip) continue;
+      sum += s;
+      ++count;
+    }
+  }
+  if (count < 30) return {edge, 0.0};
+  const double delta = std::clamp(strip - 2.0 * sum / static_cast<double>(count), 0.0, strip);
+  std::vector<Vec3> moved(n);
+  for (size_t i = 0; i < n; ++i) moved[i] = edge[i] - delta * inward[i];
+  return {moved, delta};
+}
+
+// Closest point between the lines fitted to two edges near their common corner
+// (edges start at the corner), fitted over arc range [near, far].
+Vec3 extrapolateCorner(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double near, double far) {
+  auto fit = [&](const std::vector<Vec3>& e, Vec3& point, Vec3& dir) {
+    std::vector<Vec3> pts;
+    double s = 0;
+    for (size_t i = 1; i < e.size(); ++i) {
+      s += (e[i] - e[i - 1]).norm();
+      if (s >= near && s <= far) pts.push_back(e[i]);
+    }
+    if (pts.size() < 3) return false;
+    point = Vec3::Zero();
+    for (const Vec3& p : pts) point += p;
+    point /= static_cast<double>(pts.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const Vec3& p : pts) cov += (p - point) * (p - point).transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    dir = eig.eigenvectors().col(2);
+    return true;
+  };
+  Vec3 pa, da, pb, db;
+  if (!fit(a, pa, da) || !fit(b, pb, db)) return a.front();
+  const Vec3 w = pa - pb;
+  const double A = da.dot(da), B = da.dot(db), C = db.dot(db), D = da.dot(w), E = db.dot(w);
+  const double den = A * C - B * B;
+  if (den < 1e-6) return a.front();  // edges nearly parallel: no defined corner
+  const double sa = (B * E - C * D) / den, sb = (A * E - B * D) / den;
+  return 0.5 * ((pa + sa * da) + (pb + sb * db));
 }
 
 }  // namespace
@@ -236,11 +333,45 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   out.foot = smoothPolyline(edge(tack, clew), step, window);
   out.leech = smoothPolyline(edge(clew, out.has_peak ? peak : head), step, window);
   if (out.has_peak) out.top = smoothPolyline(edge(head, peak), step, window);
+
+  // Move each edge out to where the surface really ends, then place the corners
+  // where neighbouring edges meet (a sharp corner itself is never sampled).
+  const std::vector<Vec3> normals = vertexNormals(mesh);
+  const KdTree tree(mesh.vertices);
+  double area_outside = 0;
+  for (std::vector<Vec3>* e : {&out.luff, &out.foot, &out.leech, &out.top}) {
+    if (e->empty()) continue;
+    auto [moved, delta] = pushEdgeOut(*e, mesh, normals, tree, out.boundary_spacing_m);
+    area_outside += delta * polylineLength(*e);
+    *e = smoothPolyline(moved, step, window);  // per-sample inward directions are noisy
+  }
+  auto reversed = [](std::vector<Vec3> v) {
+    std::reverse(v.begin(), v.end());
+    return v;
+  };
+  const double near = 0.5 * w, far = 2.5 * w;
+  out.tack = extrapolateCorner(out.luff, out.foot, near, far);
+  out.clew = extrapolateCorner(out.leech, reversed(out.foot), near, far);
+  if (out.has_peak) {
+    out.head = extrapolateCorner(reversed(out.luff), out.top, near, far);
+    out.peak = extrapolateCorner(reversed(out.leech), reversed(out.top), near, far);
+    out.top.front() = out.head;
+    out.top.back() = out.peak;
+    out.leech.back() = out.peak;
+  } else {
+    out.head = extrapolateCorner(reversed(out.luff), reversed(out.leech), near, far);
+    out.leech.back() = out.head;
+  }
+  out.luff.front() = out.tack;
+  out.luff.back() = out.head;
+  out.foot.front() = out.tack;
+  out.foot.back() = out.clew;
+  out.leech.front() = out.clew;
   out.luff_length_m = polylineLength(out.luff);
   out.leech_length_m = polylineLength(out.leech);
   out.foot_length_m = polylineLength(out.foot);
   out.top_length_m = polylineLength(out.top);
-  out.area_m2 = meshArea(mesh);
+  out.area_m2 = meshArea(mesh) + area_outside;
 
   if (!p.design_lengths_m.empty()) {
     const char* names[3] = {"luff", "leech", "foot"};

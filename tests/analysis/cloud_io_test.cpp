@@ -102,7 +102,9 @@ void expectSameCloud(const Cloud& expected, const Cloud& actual) {
   EXPECT_EQ(expected.alpha_rad, actual.alpha_rad);
   EXPECT_EQ(expected.beta_rad, actual.beta_rad);
   ASSERT_EQ(expected.viewpoint.has_value(), actual.viewpoint.has_value());
-  if (expected.viewpoint) EXPECT_EQ(*expected.viewpoint, *actual.viewpoint);
+  if (expected.viewpoint) {
+    EXPECT_EQ(*expected.viewpoint, *actual.viewpoint);
+  }
 }
 
 class CloudIoTest : public ::testing::Test {

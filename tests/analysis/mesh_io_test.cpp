@@ -244,18 +244,18 @@ TEST_F(MeshIoTest, PlyErrors) {
                     "line 7: PLY header has no 'element face' (a point cloud, not a mesh)");
   const std::string header = vertices3 + "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
   EXPECT_READ_ERROR(write("range.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"),
-                    "line 12: vertex index 3 out of range (3 vertices)");
+                    "line 13: vertex index 3 out of range (3 vertices)");
   EXPECT_READ_ERROR(write("negative.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"),
-                    "line 12: vertex index -1 out of range (3 vertices)");
+                    "line 13: vertex index -1 out of range (3 vertices)");
   EXPECT_READ_ERROR(write("two.ply", header + "0 0 0\n1 0 0\n0 1 0\n2 0 1\n"),
-                    "line 12: face with 2 vertices (need at least 3)");
+                    "line 13: face with 2 vertices (need at least 3)");
   EXPECT_READ_ERROR(write("short.ply", header + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n"),
-                    "line 12: too few values for list property 'vertex_indices'");
+                    "line 13: too few values for list property 'vertex_indices'");
   EXPECT_READ_ERROR(write("nan.ply", header + "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
-                    "line 10: non-finite vertex coordinate 'nan'");
-  EXPECT_READ_ERROR(write("abc.ply", header + "0 0 0\n1 abc 0\n0 1 0\n3 0 1 2\n"), "line 10: non-numeric value 'abc'");
+                    "line 11: non-finite vertex coordinate 'nan'");
+  EXPECT_READ_ERROR(write("abc.ply", header + "0 0 0\n1 abc 0\n0 1 0\n3 0 1 2\n"), "line 11: non-numeric value 'abc'");
   EXPECT_READ_ERROR(write("trunc.ply", header + "0 0 0\n1 0 0\n0 1 0\n"),
-                    "line 12: truncated data (expected 1 faces, got 0)");
+                    "line 13: truncated data (expected 1 faces, got 0)");
   EXPECT_READ_ERROR(write("zero.ply", vertices3 + "element face 0\nproperty list uchar int vertex_indices\n"
                                                   "end_header\n0 0 0\n1 0 0\n0 1 0\n"),
                     "no triangles");
@@ -367,7 +367,7 @@ TEST_F(MeshIoTest, StlErrors) {
   Bytes nan = full;
   const float bad = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(&nan.data[84 + 50 + 12 + 12 + 4], &bad, 4);
-  EXPECT_READ_ERROR(write("nan.stl", nan.data), "byte 166: non-finite vertex coordinate (triangle 1)");
+  EXPECT_READ_ERROR(write("nan.stl", nan.data), "byte 162: non-finite vertex coordinate (triangle 1)");
   Bytes empty;
   empty.text(std::string(80, ' ')).le(uint32_t{0});
   EXPECT_READ_ERROR(write("empty.stl", empty.data), "no triangles");
