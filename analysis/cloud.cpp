@@ -31,8 +31,8 @@ Cloud selectPoints(const Cloud& cloud, const std::vector<uint32_t>& indices) {
   checkAttributeSize(cloud.beta_rad, "beta_rad", n);
   for (uint32_t i : indices)
     if (i >= n)
-      throw InvalidInput("[selectPoints] index " + std::to_string(i) + " out of range (cloud has " +
-                         std::to_string(n) + " points)");
+      throw InvalidInput("[selectPoints] index " + std::to_string(i) + " out of range (cloud has " + std::to_string(n) +
+                         " points)");
 
   Cloud out;
   copyAt(cloud.points, indices, out.points);

@@ -9,7 +9,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <optional>
 #include <string_view>
 #include <system_error>
@@ -23,9 +22,7 @@ namespace {
 // ---------------------------------------------------------------------------
 // Errors: "<path>: line 7: <problem>", "<path>: byte 1234: <problem>", "<path>: <problem>".
 
-FileError fileError(const std::string& path, const std::string& problem) {
-  return FileError(path + ": " + problem);
-}
+FileError fileError(const std::string& path, const std::string& problem) { return FileError(path + ": " + problem); }
 
 FileError atLine(const std::string& path, size_t line, const std::string& problem) {
   return FileError(path + ": line " + std::to_string(line) + ": " + problem);
@@ -48,9 +45,7 @@ std::string lowercase(std::string_view s) {
   return out;
 }
 
-std::string extensionOf(const std::string& path) {
-  return lowercase(std::filesystem::path(path).extension().string());
-}
+std::string extensionOf(const std::string& path) { return lowercase(std::filesystem::path(path).extension().string()); }
 
 FileError unknownExtension(const std::string& path) {
   return fileError(path, "unknown cloud file extension '" + std::filesystem::path(path).extension().string() +
@@ -96,8 +91,7 @@ std::string_view trim(std::string_view s) {
 // Lines of a text region, '\n' or "\r\n" terminated, numbered from `first_line`.
 class LineReader {
  public:
-  LineReader(const char* begin, const char* end, size_t first_line = 1)
-      : p_(begin), end_(end), line_(first_line - 1) {}
+  LineReader(const char* begin, const char* end, size_t first_line = 1) : p_(begin), end_(end), line_(first_line - 1) {}
 
   bool next(std::string_view& line) {
     if (p_ == end_) return false;
@@ -173,9 +167,12 @@ Parsed parseNumber(std::string_view token, double& value) {
 double numberOnLine(const std::string& path, size_t line, std::string_view token) {
   double value = 0;
   switch (parseNumber(token, value)) {
-    case Parsed::Ok: return value;
-    case Parsed::OutOfRange: throw atLine(path, line, "value out of range " + quoted(token));
-    case Parsed::NotANumber: break;
+    case Parsed::Ok:
+      return value;
+    case Parsed::OutOfRange:
+      throw atLine(path, line, "value out of range " + quoted(token));
+    case Parsed::NotANumber:
+      break;
   }
   if (token.empty()) throw atLine(path, line, "empty value");
   throw atLine(path, line, "non-numeric value " + quoted(token));
@@ -210,10 +207,20 @@ enum class Scalar : uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, 
 
 size_t scalarSize(Scalar t) {
   switch (t) {
-    case Scalar::Int8: case Scalar::UInt8: return 1;
-    case Scalar::Int16: case Scalar::UInt16: return 2;
-    case Scalar::Int32: case Scalar::UInt32: case Scalar::Float32: return 4;
-    case Scalar::Int64: case Scalar::UInt64: case Scalar::Float64: return 8;
+    case Scalar::Int8:
+    case Scalar::UInt8:
+      return 1;
+    case Scalar::Int16:
+    case Scalar::UInt16:
+      return 2;
+    case Scalar::Int32:
+    case Scalar::UInt32:
+    case Scalar::Float32:
+      return 4;
+    case Scalar::Int64:
+    case Scalar::UInt64:
+    case Scalar::Float64:
+      return 8;
   }
   return 0;
 }
@@ -235,16 +242,26 @@ T loadAs(const char* p, bool swap) {
 
 double loadScalar(const char* p, Scalar t, bool swap) {
   switch (t) {
-    case Scalar::Int8: return loadAs<int8_t>(p, false);
-    case Scalar::UInt8: return loadAs<uint8_t>(p, false);
-    case Scalar::Int16: return loadAs<int16_t>(p, swap);
-    case Scalar::UInt16: return loadAs<uint16_t>(p, swap);
-    case Scalar::Int32: return loadAs<int32_t>(p, swap);
-    case Scalar::UInt32: return loadAs<uint32_t>(p, swap);
-    case Scalar::Int64: return static_cast<double>(loadAs<int64_t>(p, swap));
-    case Scalar::UInt64: return static_cast<double>(loadAs<uint64_t>(p, swap));
-    case Scalar::Float32: return loadAs<float>(p, swap);
-    case Scalar::Float64: return loadAs<double>(p, swap);
+    case Scalar::Int8:
+      return loadAs<int8_t>(p, false);
+    case Scalar::UInt8:
+      return loadAs<uint8_t>(p, false);
+    case Scalar::Int16:
+      return loadAs<int16_t>(p, swap);
+    case Scalar::UInt16:
+      return loadAs<uint16_t>(p, swap);
+    case Scalar::Int32:
+      return loadAs<int32_t>(p, swap);
+    case Scalar::UInt32:
+      return loadAs<uint32_t>(p, swap);
+    case Scalar::Int64:
+      return static_cast<double>(loadAs<int64_t>(p, swap));
+    case Scalar::UInt64:
+      return static_cast<double>(loadAs<uint64_t>(p, swap));
+    case Scalar::Float32:
+      return loadAs<float>(p, swap);
+    case Scalar::Float64:
+      return loadAs<double>(p, swap);
   }
   return 0;
 }
@@ -391,11 +408,11 @@ struct PlyHeader {
 
 std::optional<Scalar> plyScalar(std::string_view name) {
   static const std::pair<const char*, Scalar> kNames[] = {
-      {"char", Scalar::Int8},     {"int8", Scalar::Int8},       {"uchar", Scalar::UInt8},
-      {"uint8", Scalar::UInt8},   {"short", Scalar::Int16},     {"int16", Scalar::Int16},
-      {"ushort", Scalar::UInt16}, {"uint16", Scalar::UInt16},   {"int", Scalar::Int32},
-      {"int32", Scalar::Int32},   {"uint", Scalar::UInt32},     {"uint32", Scalar::UInt32},
-      {"float", Scalar::Float32}, {"float32", Scalar::Float32}, {"double", Scalar::Float64},
+      {"char", Scalar::Int8},      {"int8", Scalar::Int8},       {"uchar", Scalar::UInt8},
+      {"uint8", Scalar::UInt8},    {"short", Scalar::Int16},     {"int16", Scalar::Int16},
+      {"ushort", Scalar::UInt16},  {"uint16", Scalar::UInt16},   {"int", Scalar::Int32},
+      {"int32", Scalar::Int32},    {"uint", Scalar::UInt32},     {"uint32", Scalar::UInt32},
+      {"float", Scalar::Float32},  {"float32", Scalar::Float32}, {"double", Scalar::Float64},
       {"float64", Scalar::Float64}};
   for (const auto& [n, t] : kNames)
     if (name == n) return t;
@@ -419,10 +436,14 @@ PlyHeader parsePlyHeader(const std::string& path, const std::string& buf) {
     const std::string_view key = tok[0];
     if (key == "format") {
       if (tok.size() != 3) throw atLine(path, n, "malformed format line (expected 'format <encoding> 1.0')");
-      if (tok[1] == "ascii") header.encoding = PlyEncoding::Ascii;
-      else if (tok[1] == "binary_little_endian") header.encoding = PlyEncoding::BinaryLittleEndian;
-      else if (tok[1] == "binary_big_endian") header.encoding = PlyEncoding::BinaryBigEndian;
-      else throw atLine(path, n, "unknown PLY format " + quoted(tok[1]));
+      if (tok[1] == "ascii")
+        header.encoding = PlyEncoding::Ascii;
+      else if (tok[1] == "binary_little_endian")
+        header.encoding = PlyEncoding::BinaryLittleEndian;
+      else if (tok[1] == "binary_big_endian")
+        header.encoding = PlyEncoding::BinaryBigEndian;
+      else
+        throw atLine(path, n, "unknown PLY format " + quoted(tok[1]));
       if (tok[2] != "1.0") throw atLine(path, n, "unsupported PLY version " + quoted(tok[2]));
       have_format = true;
     } else if (key == "comment") {
@@ -492,8 +513,8 @@ FileError truncatedAtLine(const std::string& path, size_t line, const PlyElement
 }
 
 // Steps over one list property of item `item`; returns the position after it.
-size_t skipBinaryList(const std::string& path, const std::string& buf, size_t pos, const PlyProperty& p,
-                      bool swap, const PlyElement& e, uint64_t item) {
+size_t skipBinaryList(const std::string& path, const std::string& buf, size_t pos, const PlyProperty& p, bool swap,
+                      const PlyElement& e, uint64_t item) {
   const size_t count_size = scalarSize(p.count_type);
   if (buf.size() - pos < count_size) throw truncatedAtByte(path, buf.size(), e, item);
   const double count = loadScalar(buf.data() + pos, p.count_type, swap);
@@ -504,8 +525,7 @@ size_t skipBinaryList(const std::string& path, const std::string& buf, size_t po
   return pos + static_cast<size_t>(bytes);
 }
 
-size_t skipBinaryElement(const std::string& path, const std::string& buf, size_t pos, const PlyElement& e,
-                         bool swap) {
+size_t skipBinaryElement(const std::string& path, const std::string& buf, size_t pos, const PlyElement& e, bool swap) {
   if (!e.hasLists()) {
     const size_t stride = e.fixedSize();
     const size_t left = buf.size() - pos;
@@ -544,9 +564,9 @@ void readPlyBinaryVertices(const std::string& path, const std::string& buf, size
       if (role != kNoRole) {
         const double x = loadScalar(base + pos, p.type, swap);
         if (role <= kZ && std::isinf(x))
-          throw atByte(path, pos,
-                       "infinite coordinate (" + std::string(kAxisNames[role]) + " of vertex " + std::to_string(i) +
-                           ")");
+          throw atByte(
+              path, pos,
+              "infinite coordinate (" + std::string(kAxisNames[role]) + " of vertex " + std::to_string(i) + ")");
         v[role] = x;
       }
       pos += n;
@@ -555,8 +575,8 @@ void readPlyBinaryVertices(const std::string& path, const std::string& buf, size
   }
 }
 
-void readPlyAsciiVertices(const std::string& path, const std::string& buf, const PlyHeader& header,
-                          size_t vertex_index, const std::vector<int>& roles, CloudBuilder& builder) {
+void readPlyAsciiVertices(const std::string& path, const std::string& buf, const PlyHeader& header, size_t vertex_index,
+                          const std::vector<int>& roles, CloudBuilder& builder) {
   LineReader lines(buf.data() + header.data_offset, buf.data() + buf.size(), header.end_header_line + 1);
   std::string_view line;
   for (size_t e = 0; e < vertex_index; ++e) {
@@ -575,8 +595,7 @@ void readPlyAsciiVertices(const std::string& path, const std::string& buf, const
     const size_t n = lines.line();
     splitWhitespace(line, tok);
     if (!has_lists && tok.size() != props.size())
-      throw atLine(path, n,
-                   "expected " + std::to_string(props.size()) + " values, got " + std::to_string(tok.size()));
+      throw atLine(path, n, "expected " + std::to_string(props.size()) + " values, got " + std::to_string(tok.size()));
     size_t t = 0;
     for (size_t k = 0; k < props.size(); ++k) {
       if (t >= tok.size()) throw atLine(path, n, "too few values (no value for property '" + props[k].name + "')");
@@ -743,10 +762,14 @@ PcdHeader parsePcdHeader(const std::string& path, const std::string& buf) {
       if (!(origin && identity)) header.viewpoint = Vec3(v[0], v[1], v[2]);
     } else if (key == "DATA") {
       if (tok.size() != 2) throw atLine(path, n, "malformed DATA line (expected 'DATA ascii|binary')");
-      if (tok[1] == "ascii") header.binary = false;
-      else if (tok[1] == "binary") header.binary = true;
-      else if (tok[1] == "binary_compressed") throw atLine(path, n, "PCD DATA binary_compressed is not supported");
-      else throw atLine(path, n, "unknown PCD DATA type " + quoted(tok[1]));
+      if (tok[1] == "ascii")
+        header.binary = false;
+      else if (tok[1] == "binary")
+        header.binary = true;
+      else if (tok[1] == "binary_compressed")
+        throw atLine(path, n, "PCD DATA binary_compressed is not supported");
+      else
+        throw atLine(path, n, "unknown PCD DATA type " + quoted(tok[1]));
       header.data_line = n;
       header.data_offset = static_cast<size_t>(lines.position() - buf.data());
       have_data = true;
@@ -761,15 +784,18 @@ PcdHeader parsePcdHeader(const std::string& path, const std::string& buf) {
   const size_t dl = header.data_line;
   if (names.empty()) throw atLine(path, dl, "PCD header has no FIELDS");
   if (sizes.size() != names.size())
-    throw atLine(path, size_line ? size_line : dl,
-                 "SIZE has " + std::to_string(sizes.size()) + " entries but FIELDS has " + std::to_string(names.size()));
+    throw atLine(
+        path, size_line ? size_line : dl,
+        "SIZE has " + std::to_string(sizes.size()) + " entries but FIELDS has " + std::to_string(names.size()));
   if (types.size() != names.size())
-    throw atLine(path, type_line ? type_line : dl,
-                 "TYPE has " + std::to_string(types.size()) + " entries but FIELDS has " + std::to_string(names.size()));
+    throw atLine(
+        path, type_line ? type_line : dl,
+        "TYPE has " + std::to_string(types.size()) + " entries but FIELDS has " + std::to_string(names.size()));
   if (counts.empty()) counts.assign(names.size(), 1);
   if (counts.size() != names.size())
-    throw atLine(path, count_line,
-                 "COUNT has " + std::to_string(counts.size()) + " entries but FIELDS has " + std::to_string(names.size()));
+    throw atLine(
+        path, count_line,
+        "COUNT has " + std::to_string(counts.size()) + " entries but FIELDS has " + std::to_string(names.size()));
 
   for (size_t i = 0; i < names.size(); ++i) {
     PcdField f;
@@ -788,9 +814,12 @@ PcdHeader parsePcdHeader(const std::string& path, const std::string& buf) {
     header.values_per_point += counts[i];
     header.fields.push_back(f);
   }
-  if (points) header.points = *points;
-  else if (width) header.points = *width * height.value_or(1);
-  else throw atLine(path, dl, "PCD header has neither POINTS nor WIDTH");
+  if (points)
+    header.points = *points;
+  else if (width)
+    header.points = *width * height.value_or(1);
+  else
+    throw atLine(path, dl, "PCD header has neither POINTS nor WIDTH");
   return header;
 }
 
@@ -825,9 +854,9 @@ CloudReadResult readPcd(const std::string& path, const std::string& buf) {
         const char* p = record + field->byte_offset;
         const double x = loadScalar(p, field->type, swap);
         if (role <= kZ && std::isinf(x))
-          throw atByte(path, static_cast<size_t>(p - buf.data()),
-                       "infinite coordinate (" + std::string(kAxisNames[role]) + " of point " + std::to_string(i) +
-                           ")");
+          throw atByte(
+              path, static_cast<size_t>(p - buf.data()),
+              "infinite coordinate (" + std::string(kAxisNames[role]) + " of point " + std::to_string(i) + ")");
         v[role] = x;
       }
       builder.add(v);
@@ -841,15 +870,15 @@ CloudReadResult readPcd(const std::string& path, const std::string& buf) {
   std::vector<std::string_view> tok;
   for (uint64_t i = 0; i < header.points; ++i) {
     if (!lines.nextNonEmpty(line))
-      throw atLine(path, lines.line() + 1,
-                   "truncated data (expected " + std::to_string(header.points) + " points, got " + std::to_string(i) +
-                       ")");
+      throw atLine(
+          path, lines.line() + 1,
+          "truncated data (expected " + std::to_string(header.points) + " points, got " + std::to_string(i) + ")");
     const size_t n = lines.line();
     splitWhitespace(line, tok);
     if (tok.size() != header.values_per_point)
-      throw atLine(path, n,
-                   "expected " + std::to_string(header.values_per_point) + " values, got " +
-                       std::to_string(tok.size()));
+      throw atLine(
+          path, n,
+          "expected " + std::to_string(header.values_per_point) + " values, got " + std::to_string(tok.size()));
     for (const auto& [role, field] : used) {
       const std::string_view token = tok[field->value_index];
       const double x = numberOnLine(path, n, token);
@@ -878,12 +907,10 @@ CloudReadResult readText(const std::string& path, const std::string& buf, const 
   std::vector<std::string_view> comment_tok;
   std::optional<Vec3> viewpoint;
 
-  bool columns_known = false;
   std::array<int, kRoleCount> column;  // column of each role, -1 when absent
   column.fill(-1);
   size_t needed = 0;
-  std::array<bool, kRoleCount> present{};
-  std::optional<CloudBuilder> builder;
+  std::optional<CloudBuilder> builder;  // made once the first line fixes the columns
   double v[kRoleCount] = {};
 
   while (lines.next(line)) {
@@ -897,8 +924,7 @@ CloudReadResult readText(const std::string& path, const std::string& buf, const 
     }
     splitFields(t, tok);
 
-    if (!columns_known) {
-      columns_known = true;
+    if (!builder) {
       const bool is_header = std::none_of(tok.begin(), tok.end(), [](std::string_view s) {
         double x;
         return parseNumber(s, x) != Parsed::NotANumber;
@@ -910,19 +936,19 @@ CloudReadResult readText(const std::string& path, const std::string& buf, const 
         for (size_t c = 0; c < roles.size(); ++c)
           if (roles[c] != kNoRole) column[roles[c]] = static_cast<int>(c);
         for (int axis = kX; axis <= kZ; ++axis)
-          if (column[axis] < 0)
-            throw atLine(path, n, "header has no '" + std::string(kAxisNames[axis]) + "' column");
+          if (column[axis] < 0) throw atLine(path, n, "header has no '" + std::string(kAxisNames[axis]) + "' column");
       } else {
         column[kX] = 0;
         column[kY] = 1;
         column[kZ] = 2;
         if (tok.size() >= 4) column[kIntensity] = 3;
       }
+      std::array<bool, kRoleCount> present{};
       for (int r = 0; r < kRoleCount; ++r) {
         present[r] = column[r] >= 0;
         needed = std::max<size_t>(needed, static_cast<size_t>(column[r] + 1));
       }
-      builder.emplace(present, reserveFor(std::numeric_limits<uint64_t>::max(), buf.size(), 8 * needed));
+      builder.emplace(present, static_cast<size_t>(std::count(buf.begin(), buf.end(), '\n')) + 1);
       if (is_header) continue;
     }
 
@@ -1101,22 +1127,40 @@ void writeCloud(const std::string& path, const Cloud& cloud, CloudFormat format)
 
   if (format == CloudFormat::Auto) {
     const std::string ext = extensionOf(path);
-    if (ext == ".ply") format = CloudFormat::PlyBinary;
-    else if (ext == ".pcd") format = CloudFormat::PcdBinary;
-    else if (ext == ".csv") format = CloudFormat::Csv;
-    else if (ext == ".xyz" || ext == ".txt") format = CloudFormat::Xyz;
-    else throw unknownExtension(path);
+    if (ext == ".ply")
+      format = CloudFormat::PlyBinary;
+    else if (ext == ".pcd")
+      format = CloudFormat::PcdBinary;
+    else if (ext == ".csv")
+      format = CloudFormat::Csv;
+    else if (ext == ".xyz" || ext == ".txt")
+      format = CloudFormat::Xyz;
+    else
+      throw unknownExtension(path);
   }
 
   std::string content;
   switch (format) {
-    case CloudFormat::PlyAscii: content = plyContent(cloud, c, false); break;
-    case CloudFormat::PlyBinary: content = plyContent(cloud, c, true); break;
-    case CloudFormat::PcdAscii: content = pcdContent(cloud, c, false); break;
-    case CloudFormat::PcdBinary: content = pcdContent(cloud, c, true); break;
-    case CloudFormat::Xyz: content = textContent(cloud, c, false); break;
-    case CloudFormat::Csv: content = textContent(cloud, c, true); break;
-    case CloudFormat::Auto: break;
+    case CloudFormat::PlyAscii:
+      content = plyContent(cloud, c, false);
+      break;
+    case CloudFormat::PlyBinary:
+      content = plyContent(cloud, c, true);
+      break;
+    case CloudFormat::PcdAscii:
+      content = pcdContent(cloud, c, false);
+      break;
+    case CloudFormat::PcdBinary:
+      content = pcdContent(cloud, c, true);
+      break;
+    case CloudFormat::Xyz:
+      content = textContent(cloud, c, false);
+      break;
+    case CloudFormat::Csv:
+      content = textContent(cloud, c, true);
+      break;
+    case CloudFormat::Auto:
+      break;
   }
   writeWholeFile(path, content);
 }

@@ -26,9 +26,7 @@ namespace {
 // ---------------------------------------------------------------------------
 // Errors: "<path>: line 7: <problem>", "<path>: byte 1234: <problem>", "<path>: <problem>".
 
-FileError fileError(const std::string& path, const std::string& problem) {
-  return FileError(path + ": " + problem);
-}
+FileError fileError(const std::string& path, const std::string& problem) { return FileError(path + ": " + problem); }
 
 FileError atLine(const std::string& path, size_t line, const std::string& problem) {
   return FileError(path + ": line " + std::to_string(line) + ": " + problem);
@@ -51,9 +49,7 @@ std::string lowercase(std::string_view s) {
   return out;
 }
 
-std::string extensionOf(const std::string& path) {
-  return lowercase(std::filesystem::path(path).extension().string());
-}
+std::string extensionOf(const std::string& path) { return lowercase(std::filesystem::path(path).extension().string()); }
 
 // ---------------------------------------------------------------------------
 // Whole-file I/O.
@@ -94,8 +90,7 @@ std::string_view trim(std::string_view s) {
 // Lines of a text region, '\n' or "\r\n" terminated, numbered from `first_line`.
 class LineReader {
  public:
-  LineReader(const char* begin, const char* end, size_t first_line = 1)
-      : p_(begin), end_(end), line_(first_line - 1) {}
+  LineReader(const char* begin, const char* end, size_t first_line = 1) : p_(begin), end_(end), line_(first_line - 1) {}
 
   bool next(std::string_view& line) {
     if (p_ == end_) return false;
@@ -154,9 +149,12 @@ Parsed parseNumber(std::string_view token, double& value) {
 double numberOnLine(const std::string& path, size_t line, std::string_view token) {
   double value = 0;
   switch (parseNumber(token, value)) {
-    case Parsed::Ok: return value;
-    case Parsed::OutOfRange: throw atLine(path, line, "value out of range " + quoted(token));
-    case Parsed::NotANumber: break;
+    case Parsed::Ok:
+      return value;
+    case Parsed::OutOfRange:
+      throw atLine(path, line, "value out of range " + quoted(token));
+    case Parsed::NotANumber:
+      break;
   }
   if (token.empty()) throw atLine(path, line, "empty value");
   throw atLine(path, line, "non-numeric value " + quoted(token));
@@ -179,10 +177,20 @@ enum class Scalar : uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, 
 
 size_t scalarSize(Scalar t) {
   switch (t) {
-    case Scalar::Int8: case Scalar::UInt8: return 1;
-    case Scalar::Int16: case Scalar::UInt16: return 2;
-    case Scalar::Int32: case Scalar::UInt32: case Scalar::Float32: return 4;
-    case Scalar::Int64: case Scalar::UInt64: case Scalar::Float64: return 8;
+    case Scalar::Int8:
+    case Scalar::UInt8:
+      return 1;
+    case Scalar::Int16:
+    case Scalar::UInt16:
+      return 2;
+    case Scalar::Int32:
+    case Scalar::UInt32:
+    case Scalar::Float32:
+      return 4;
+    case Scalar::Int64:
+    case Scalar::UInt64:
+    case Scalar::Float64:
+      return 8;
   }
   return 0;
 }
@@ -204,16 +212,26 @@ T loadAs(const char* p, bool swap) {
 
 double loadScalar(const char* p, Scalar t, bool swap) {
   switch (t) {
-    case Scalar::Int8: return loadAs<int8_t>(p, false);
-    case Scalar::UInt8: return loadAs<uint8_t>(p, false);
-    case Scalar::Int16: return loadAs<int16_t>(p, swap);
-    case Scalar::UInt16: return loadAs<uint16_t>(p, swap);
-    case Scalar::Int32: return loadAs<int32_t>(p, swap);
-    case Scalar::UInt32: return loadAs<uint32_t>(p, swap);
-    case Scalar::Int64: return static_cast<double>(loadAs<int64_t>(p, swap));
-    case Scalar::UInt64: return static_cast<double>(loadAs<uint64_t>(p, swap));
-    case Scalar::Float32: return loadAs<float>(p, swap);
-    case Scalar::Float64: return loadAs<double>(p, swap);
+    case Scalar::Int8:
+      return loadAs<int8_t>(p, false);
+    case Scalar::UInt8:
+      return loadAs<uint8_t>(p, false);
+    case Scalar::Int16:
+      return loadAs<int16_t>(p, swap);
+    case Scalar::UInt16:
+      return loadAs<uint16_t>(p, swap);
+    case Scalar::Int32:
+      return loadAs<int32_t>(p, swap);
+    case Scalar::UInt32:
+      return loadAs<uint32_t>(p, swap);
+    case Scalar::Int64:
+      return static_cast<double>(loadAs<int64_t>(p, swap));
+    case Scalar::UInt64:
+      return static_cast<double>(loadAs<uint64_t>(p, swap));
+    case Scalar::Float32:
+      return loadAs<float>(p, swap);
+    case Scalar::Float64:
+      return loadAs<double>(p, swap);
   }
   return 0;
 }
@@ -273,11 +291,11 @@ struct PlyHeader {
 
 std::optional<Scalar> plyScalar(std::string_view name) {
   static const std::pair<const char*, Scalar> kNames[] = {
-      {"char", Scalar::Int8},     {"int8", Scalar::Int8},       {"uchar", Scalar::UInt8},
-      {"uint8", Scalar::UInt8},   {"short", Scalar::Int16},     {"int16", Scalar::Int16},
-      {"ushort", Scalar::UInt16}, {"uint16", Scalar::UInt16},   {"int", Scalar::Int32},
-      {"int32", Scalar::Int32},   {"uint", Scalar::UInt32},     {"uint32", Scalar::UInt32},
-      {"float", Scalar::Float32}, {"float32", Scalar::Float32}, {"double", Scalar::Float64},
+      {"char", Scalar::Int8},      {"int8", Scalar::Int8},       {"uchar", Scalar::UInt8},
+      {"uint8", Scalar::UInt8},    {"short", Scalar::Int16},     {"int16", Scalar::Int16},
+      {"ushort", Scalar::UInt16},  {"uint16", Scalar::UInt16},   {"int", Scalar::Int32},
+      {"int32", Scalar::Int32},    {"uint", Scalar::UInt32},     {"uint32", Scalar::UInt32},
+      {"float", Scalar::Float32},  {"float32", Scalar::Float32}, {"double", Scalar::Float64},
       {"float64", Scalar::Float64}};
   for (const auto& [n, t] : kNames)
     if (name == n) return t;
@@ -301,10 +319,14 @@ PlyHeader parsePlyHeader(const std::string& path, const std::string& buf) {
     const std::string_view key = tok[0];
     if (key == "format") {
       if (tok.size() != 3) throw atLine(path, n, "malformed format line (expected 'format <encoding> 1.0')");
-      if (tok[1] == "ascii") header.encoding = PlyEncoding::Ascii;
-      else if (tok[1] == "binary_little_endian") header.encoding = PlyEncoding::BinaryLittleEndian;
-      else if (tok[1] == "binary_big_endian") header.encoding = PlyEncoding::BinaryBigEndian;
-      else throw atLine(path, n, "unknown PLY format " + quoted(tok[1]));
+      if (tok[1] == "ascii")
+        header.encoding = PlyEncoding::Ascii;
+      else if (tok[1] == "binary_little_endian")
+        header.encoding = PlyEncoding::BinaryLittleEndian;
+      else if (tok[1] == "binary_big_endian")
+        header.encoding = PlyEncoding::BinaryBigEndian;
+      else
+        throw atLine(path, n, "unknown PLY format " + quoted(tok[1]));
       if (tok[2] != "1.0") throw atLine(path, n, "unsupported PLY version " + quoted(tok[2]));
       have_format = true;
     } else if (key == "comment" || key == "obj_info") {
@@ -372,8 +394,8 @@ FileError truncatedAtLine(const std::string& path, size_t line, const PlyElement
 }
 
 // Steps over one list property of item `item`; returns the position after it.
-size_t skipBinaryList(const std::string& path, const std::string& buf, size_t pos, const PlyProperty& p,
-                      bool swap, const PlyElement& e, uint64_t item) {
+size_t skipBinaryList(const std::string& path, const std::string& buf, size_t pos, const PlyProperty& p, bool swap,
+                      const PlyElement& e, uint64_t item) {
   const size_t count_size = scalarSize(p.count_type);
   if (buf.size() - pos < count_size) throw truncatedAtByte(path, buf.size(), e, item);
   const double count = loadScalar(buf.data() + pos, p.count_type, swap);
@@ -384,8 +406,7 @@ size_t skipBinaryList(const std::string& path, const std::string& buf, size_t po
   return pos + static_cast<size_t>(bytes);
 }
 
-size_t skipBinaryElement(const std::string& path, const std::string& buf, size_t pos, const PlyElement& e,
-                         bool swap) {
+size_t skipBinaryElement(const std::string& path, const std::string& buf, size_t pos, const PlyElement& e, bool swap) {
   if (!e.hasLists()) {
     const size_t stride = e.fixedSize();
     const size_t left = buf.size() - pos;
@@ -404,7 +425,6 @@ size_t skipBinaryElement(const std::string& path, const std::string& buf, size_t
     }
   return pos;
 }
-
 
 FileError unknownMeshExtension(const std::string& path) {
   return fileError(path, "unknown mesh file extension '" + std::filesystem::path(path).extension().string() +
@@ -460,7 +480,7 @@ class VertexMerger {
 // PLY meshes: element vertex (x y z) and element face (list vertex_indices), in either order.
 
 struct PlyMeshLayout {
-  size_t vertex = 0;      // element indices in the header
+  size_t vertex = 0;  // element indices in the header
   size_t face = 0;
   uint64_t n_vertices = 0;
   std::vector<int> axis;  // per vertex property: 0/1/2 for x/y/z, -1 for others
@@ -477,7 +497,8 @@ PlyMeshLayout plyMeshLayout(const std::string& path, const PlyHeader& header) {
   PlyMeshLayout layout;
   layout.vertex = find("vertex");
   layout.face = find("face");
-  if (layout.vertex == elements.size()) throw atLine(path, header.end_header_line, "PLY header has no 'element vertex'");
+  if (layout.vertex == elements.size())
+    throw atLine(path, header.end_header_line, "PLY header has no 'element vertex'");
   if (layout.face == elements.size())
     throw atLine(path, header.end_header_line, "PLY header has no 'element face' (a point cloud, not a mesh)");
 
@@ -535,10 +556,11 @@ void readPlyMeshBinary(const std::string& path, const std::string& buf, const Pl
           const double count = loadScalar(base + pos, p.count_type, swap);
           if (count < 3) throw atByte(path, pos, tooFewCorners(static_cast<long long>(count)));
           pos += count_size;
+          const uint64_t corners = static_cast<uint64_t>(count);  // the count type is an integer type
           const size_t item = scalarSize(p.type);
-          if ((size - pos) / item < count) throw truncatedAtByte(path, size, el, i);
+          if ((size - pos) / item < corners) throw truncatedAtByte(path, size, el, i);
           polygon.clear();
-          for (size_t j = 0; j < static_cast<size_t>(count); ++j, pos += item) {
+          for (uint64_t j = 0; j < corners; ++j, pos += item) {
             const double index = loadScalar(base + pos, p.type, swap);
             if (index < 0 || index >= static_cast<double>(layout.n_vertices))
               throw atByte(path, pos, outOfRange(static_cast<long long>(index), layout.n_vertices));
@@ -553,7 +575,8 @@ void readPlyMeshBinary(const std::string& path, const std::string& buf, const Pl
           if (is_vertex && layout.axis[k] >= 0) {
             const double x = loadScalar(base + pos, p.type, swap);
             if (!std::isfinite(x))
-              throw atByte(path, pos, "non-finite vertex coordinate (" + p.name + " of vertex " + std::to_string(i) + ")");
+              throw atByte(path, pos,
+                           "non-finite vertex coordinate (" + p.name + " of vertex " + std::to_string(i) + ")");
             v[layout.axis[k]] = x;
           }
           pos += n;
@@ -627,8 +650,10 @@ Mesh readPlyMesh(const std::string& path, const std::string& buf) {
   Mesh mesh;
   mesh.vertices.reserve(
       static_cast<size_t>(std::min<uint64_t>(layout.n_vertices, (buf.size() - header.data_offset) / 3)));
-  if (header.encoding == PlyEncoding::Ascii) readPlyMeshAscii(path, buf, header, layout, mesh);
-  else readPlyMeshBinary(path, buf, header, layout, mesh);
+  if (header.encoding == PlyEncoding::Ascii)
+    readPlyMeshAscii(path, buf, header, layout, mesh);
+  else
+    readPlyMeshBinary(path, buf, header, layout, mesh);
   return mesh;
 }
 
@@ -648,8 +673,7 @@ Mesh readObj(const std::string& path, const std::string& buf) {
     splitWhitespace(line, tok);
     if (tok.empty() || tok[0].front() == '#') continue;
     if (tok[0] == "v") {
-      if (tok.size() < 4)
-        throw atLine(path, n, "expected 3 coordinates, got " + std::to_string(tok.size() - 1));
+      if (tok.size() < 4) throw atLine(path, n, "expected 3 coordinates, got " + std::to_string(tok.size() - 1));
       Vec3 v;
       for (int k = 0; k < 3; ++k) {
         v[k] = numberOnLine(path, n, tok[1 + k]);
@@ -691,9 +715,7 @@ Mesh readObj(const std::string& path, const std::string& buf) {
 constexpr size_t kStlHeaderBytes = 84;  // 80-byte header + uint32 triangle count
 constexpr size_t kStlTriangleBytes = 50;
 
-uint64_t stlBinaryCount(const std::string& buf) {
-  return loadAs<uint32_t>(buf.data() + 80, !kHostLittleEndian);
-}
+uint64_t stlBinaryCount(const std::string& buf) { return loadAs<uint32_t>(buf.data() + 80, !kHostLittleEndian); }
 
 // Binary files may also start with "solid": the size decides first.
 bool isAsciiStl(const std::string& buf) {
@@ -710,9 +732,9 @@ Mesh readStlBinary(const std::string& path, const std::string& buf) {
   const uint64_t count = stlBinaryCount(buf);
   const size_t available = (buf.size() - kStlHeaderBytes) / kStlTriangleBytes;
   if (count > available)
-    throw atByte(path, buf.size(),
-                 "truncated data (expected " + std::to_string(count) + " triangles, got " + std::to_string(available) +
-                     ")");
+    throw atByte(
+        path, buf.size(),
+        "truncated data (expected " + std::to_string(count) + " triangles, got " + std::to_string(available) + ")");
   Mesh mesh;
   mesh.triangles.reserve(static_cast<size_t>(count));
   VertexMerger merger(mesh);
@@ -753,7 +775,8 @@ Mesh readStlAscii(const std::string& path, const std::string& buf) {
     if (key == "solid") {
       if (in_facet) throw atLine(path, n, "'solid' inside the facet of line " + std::to_string(facet_line));
     } else if (key == "facet") {
-      if (in_facet) throw atLine(path, n, "'facet' before 'endfacet' of the facet of line " + std::to_string(facet_line));
+      if (in_facet)
+        throw atLine(path, n, "'facet' before 'endfacet' of the facet of line " + std::to_string(facet_line));
       in_facet = true;
       facet_line = n;
     } else if (key == "outer") {
@@ -840,8 +863,8 @@ std::string objContent(const Mesh& mesh) {
     out += '\n';
   }
   for (const auto& tri : mesh.triangles)
-    out += "f " + std::to_string(tri[0] + 1) + ' ' + std::to_string(tri[1] + 1) + ' ' + std::to_string(tri[2] + 1) +
-           '\n';
+    out +=
+        "f " + std::to_string(tri[0] + 1) + ' ' + std::to_string(tri[1] + 1) + ' ' + std::to_string(tri[2] + 1) + '\n';
   return out;
 }
 
@@ -892,19 +915,34 @@ void writeMesh(const std::string& path, const Mesh& mesh, MeshFormat format) {
   checkTriangles(mesh);
   if (format == MeshFormat::Auto) {
     const std::string ext = extensionOf(path);
-    if (ext == ".ply") format = MeshFormat::PlyBinary;
-    else if (ext == ".obj") format = MeshFormat::Obj;
-    else if (ext == ".stl") format = MeshFormat::StlBinary;
-    else throw unknownMeshExtension(path);
+    if (ext == ".ply")
+      format = MeshFormat::PlyBinary;
+    else if (ext == ".obj")
+      format = MeshFormat::Obj;
+    else if (ext == ".stl")
+      format = MeshFormat::StlBinary;
+    else
+      throw unknownMeshExtension(path);
   }
   std::string content;
   switch (format) {
-    case MeshFormat::PlyAscii: content = plyMeshContent(mesh, false); break;
-    case MeshFormat::PlyBinary: content = plyMeshContent(mesh, true); break;
-    case MeshFormat::Obj: content = objContent(mesh); break;
-    case MeshFormat::StlAscii: content = stlContent(mesh, false); break;
-    case MeshFormat::StlBinary: content = stlContent(mesh, true); break;
-    case MeshFormat::Auto: break;
+    case MeshFormat::PlyAscii:
+      content = plyMeshContent(mesh, false);
+      break;
+    case MeshFormat::PlyBinary:
+      content = plyMeshContent(mesh, true);
+      break;
+    case MeshFormat::Obj:
+      content = objContent(mesh);
+      break;
+    case MeshFormat::StlAscii:
+      content = stlContent(mesh, false);
+      break;
+    case MeshFormat::StlBinary:
+      content = stlContent(mesh, true);
+      break;
+    case MeshFormat::Auto:
+      break;
   }
   writeWholeFile(path, content);
 }
@@ -914,9 +952,12 @@ Mesh readMesh(const std::string& path) {
   if (ext != ".ply" && ext != ".obj" && ext != ".stl") throw unknownMeshExtension(path);
   const std::string buf = readWholeFile(path);
   Mesh mesh;
-  if (ext == ".ply") mesh = readPlyMesh(path, buf);
-  else if (ext == ".obj") mesh = readObj(path, buf);
-  else mesh = isAsciiStl(buf) ? readStlAscii(path, buf) : readStlBinary(path, buf);
+  if (ext == ".ply")
+    mesh = readPlyMesh(path, buf);
+  else if (ext == ".obj")
+    mesh = readObj(path, buf);
+  else
+    mesh = isAsciiStl(buf) ? readStlAscii(path, buf) : readStlBinary(path, buf);
   if (mesh.triangles.empty()) throw fileError(path, "no triangles");
   return mesh;
 }

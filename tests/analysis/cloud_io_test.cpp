@@ -43,10 +43,10 @@ void expectFileError(const std::function<void()>& f, const std::string& prefix, 
 }
 
 // readCloud(path) must fail with "<path>: ..." containing every part.
-#define EXPECT_READ_ERROR(path, ...)                                                      \
-  do {                                                                                    \
-    SCOPED_TRACE("readCloud(" + std::string(path) + ")");                                 \
-    const std::string p_ = (path);                                                        \
+#define EXPECT_READ_ERROR(path, ...)                                                           \
+  do {                                                                                         \
+    SCOPED_TRACE("readCloud(" + std::string(path) + ")");                                      \
+    const std::string p_ = (path);                                                             \
     expectFileError([&] { readCloud(p_); }, p_ + ": ", std::vector<std::string>{__VA_ARGS__}); \
   } while (0)
 
@@ -113,7 +113,8 @@ class CloudIoTest : public ::testing::Test {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::string name = std::string(info->test_suite_name()) + "_" + info->name();
-    std::replace_if(name.begin(), name.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
+    std::replace_if(
+        name.begin(), name.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
     const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
     dir_ = fs::temp_directory_path() /
            ("sailshape_" + name + "_" + std::to_string(stamp) + "_" + std::to_string(counter++));
@@ -193,9 +194,9 @@ INSTANTIATE_TEST_SUITE_P(AllFormats, CloudRoundTrip,
 
 TEST_F(CloudIoTest, AutoFormatFollowsExtension) {
   const Cloud cloud = makeCloud(20, true);
-  const std::pair<const char*, const char*> cases[] = {
-      {"a.ply", "ply-binary"}, {"a.PLY", "ply-binary"}, {"a.pcd", "pcd-binary"},
-      {"a.csv", "csv"},        {"a.xyz", "xyz"},        {"a.txt", "xyz"}};
+  const std::pair<const char*, const char*> cases[] = {{"a.ply", "ply-binary"}, {"a.PLY", "ply-binary"},
+                                                       {"a.pcd", "pcd-binary"}, {"a.csv", "csv"},
+                                                       {"a.xyz", "xyz"},        {"a.txt", "xyz"}};
   for (const auto& [file, format] : cases) {
     writeCloud(path(file), cloud);
     const CloudReadResult r = readCloud(path(file));
@@ -237,8 +238,8 @@ TEST_F(CloudIoTest, WriteRejectsBadInput) {
 TEST_F(CloudIoTest, MissingFileAndUnknownExtension) {
   EXPECT_READ_ERROR(path("missing.ply"), "cannot open file");
   const std::string foo = write("c.foo", "1 2 3\n");
-  expectFileError([&] { readCloud(foo); }, foo + ": unknown cloud file extension '.foo' (expected .ply .pcd .xyz .txt .csv)",
-                  {});
+  expectFileError([&] { readCloud(foo); },
+                  foo + ": unknown cloud file extension '.foo' (expected .ply .pcd .xyz .txt .csv)", {});
   fs::create_directories(path("dir.ply"));
   EXPECT_READ_ERROR(path("dir.ply"), "cannot open file");
 }
@@ -313,8 +314,9 @@ TEST_F(CloudIoTest, PlyAsciiWithFacesAfterVertices) {
 
 TEST_F(CloudIoTest, PlyBinaryNaNPointsAreDroppedWithWarning) {
   Bytes b;
-  b.text("ply\nformat binary_little_endian 1.0\nelement vertex 5\nproperty double x\nproperty double y\n"
-         "property double z\nproperty float intensity\nend_header\n");
+  b.text(
+      "ply\nformat binary_little_endian 1.0\nelement vertex 5\nproperty double x\nproperty double y\n"
+      "property double z\nproperty float intensity\nend_header\n");
   const double xs[5][3] = {{1, 2, 3}, {kNaN, 0, 0}, {4, 5, 6}, {0, 0, kNaN}, {7, 8, 9}};
   for (int i = 0; i < 5; ++i) b.le(xs[i][0]).le(xs[i][1]).le(xs[i][2]).le(static_cast<float>(i));
   const CloudReadResult r = readCloud(write("nan.ply", b.data));
@@ -348,13 +350,15 @@ TEST_F(CloudIoTest, PlyBinaryErrors) {
   EXPECT_READ_ERROR(write("allnan.ply", all_nan.data), "no finite points (all 10 points have NaN coordinates)");
 
   Bytes face_first;
-  face_first.text("ply\nformat binary_little_endian 1.0\nelement face 2\nproperty list uchar int vertex_indices\n"
-                  "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
+  face_first.text(
+      "ply\nformat binary_little_endian 1.0\nelement face 2\nproperty list uchar int vertex_indices\n"
+      "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
   face_first.le(uint8_t{3}).le(int32_t{0}).le(int32_t{0});  // the first face's list ends early
   EXPECT_READ_ERROR(write("facetrunc.ply", face_first.data), "byte", "truncated data (expected 2 faces, got 0)");
 
-  EXPECT_READ_ERROR(write("empty.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\n"
-                                        "property float y\nproperty float z\nend_header\n"),
+  EXPECT_READ_ERROR(write("empty.ply",
+                          "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\n"
+                          "property float y\nproperty float z\nend_header\n"),
                     "no points");
 }
 
@@ -363,14 +367,16 @@ TEST_F(CloudIoTest, PlyHeaderErrors) {
   EXPECT_READ_ERROR(write("empty.ply", ""), "line 1: not a PLY file");
   EXPECT_READ_ERROR(write("format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n"),
                     "line 2: unknown PLY format 'binary_middle_endian'");
-  EXPECT_READ_ERROR(write("version.ply", "ply\nformat ascii 2.0\nend_header\n"), "line 2: unsupported PLY version '2.0'");
+  EXPECT_READ_ERROR(write("version.ply", "ply\nformat ascii 2.0\nend_header\n"),
+                    "line 2: unsupported PLY version '2.0'");
   EXPECT_READ_ERROR(write("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty real y\n"),
                     "line 5: unknown PLY property type 'real'");
   EXPECT_READ_ERROR(write("listtype.ply", "ply\nformat ascii 1.0\nelement face 1\nproperty list float int v\n"),
                     "line 4: list count type must be an integer type");
   EXPECT_READ_ERROR(write("noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"),
                     "line 4: truncated PLY header (no 'end_header')");
-  EXPECT_READ_ERROR(write("noformat.ply", "ply\nelement vertex 1\nend_header\n"), "line 3: PLY header has no 'format' line");
+  EXPECT_READ_ERROR(write("noformat.ply", "ply\nelement vertex 1\nend_header\n"),
+                    "line 3: PLY header has no 'format' line");
   EXPECT_READ_ERROR(write("noelement.ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n"),
                     "line 3: property before any element");
   EXPECT_READ_ERROR(write("count.ply", "ply\nformat ascii 1.0\nelement vertex many\nend_header\n"),
@@ -379,11 +385,13 @@ TEST_F(CloudIoTest, PlyHeaderErrors) {
                     "line 3: unknown PLY header keyword 'elemnet'");
   EXPECT_READ_ERROR(write("novertex.ply", "ply\nformat ascii 1.0\nelement face 0\nend_header\n"),
                     "line 4: PLY header has no 'element vertex'");
-  EXPECT_READ_ERROR(write("noz.ply", "ply\nformat ascii 1.0\ncomment x\nelement vertex 1\nproperty float x\n"
-                                     "property float y\nend_header\n0 0\n"),
+  EXPECT_READ_ERROR(write("noz.ply",
+                          "ply\nformat ascii 1.0\ncomment x\nelement vertex 1\nproperty float x\n"
+                          "property float y\nend_header\n0 0\n"),
                     "line 4: PLY vertex element has no 'z' property");
-  EXPECT_READ_ERROR(write("listx.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\n"
-                                       "property float y\nproperty float z\nend_header\n"),
+  EXPECT_READ_ERROR(write("listx.ply",
+                          "ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\n"
+                          "property float y\nproperty float z\nend_header\n"),
                     "line 4: vertex property 'x' is a list");
 }
 
@@ -394,7 +402,8 @@ TEST_F(CloudIoTest, PlyAsciiErrors) {
   EXPECT_READ_ERROR(write("garbage.ply", header + "0 0 0\n1 2 1.5abc\n"), "line 9: non-numeric value '1.5abc'");
   EXPECT_READ_ERROR(write("count.ply", header + "0 0 0\n1 2\n"), "line 9: expected 3 values, got 2");
   EXPECT_READ_ERROR(write("extra.ply", header + "0 0 0 0\n"), "line 8: expected 3 values, got 4");
-  EXPECT_READ_ERROR(write("trunc.ply", header + "0 0 0\n1 1 1\n"), "line 10: truncated data (expected 3 vertices, got 2)");
+  EXPECT_READ_ERROR(write("trunc.ply", header + "0 0 0\n1 1 1\n"),
+                    "line 10: truncated data (expected 3 vertices, got 2)");
   EXPECT_READ_ERROR(write("inf.ply", header + "0 0 0\n1 -inf 1\n2 2 2\n"), "line 9: infinite coordinate '-inf'");
   EXPECT_READ_ERROR(write("range.ply", header + "0 0 1e999\n"), "line 8: value out of range '1e999'");
   const CloudReadResult r = readCloud(write("nan.ply", header + "0 0 0\nnan 1 1\n2 2 NaN\n"));
@@ -423,8 +432,9 @@ TEST_F(CloudIoTest, PcdAsciiLikePcl) {
 
 TEST_F(CloudIoTest, PcdBinaryMixedTypesAndViewpoint) {
   Bytes b;
-  b.text("VERSION .7\nFIELDS ring x y z intensity\nSIZE 2 4 4 8 1\nTYPE U F F F U\nCOUNT 1 1 1 1 1\n"
-         "WIDTH 2\nHEIGHT 1\nVIEWPOINT 1 2 3 0.7071 0 0 0.7071\nPOINTS 2\nDATA binary\n");
+  b.text(
+      "VERSION .7\nFIELDS ring x y z intensity\nSIZE 2 4 4 8 1\nTYPE U F F F U\nCOUNT 1 1 1 1 1\n"
+      "WIDTH 2\nHEIGHT 1\nVIEWPOINT 1 2 3 0.7071 0 0 0.7071\nPOINTS 2\nDATA binary\n");
   b.le(uint16_t{1}).le(1.5f).le(2.5f).le(3.25).le(uint8_t{17});
   b.le(uint16_t{2}).le(-1.5f).le(0.f).le(kNaN).le(uint8_t{18});
   const CloudReadResult r = readCloud(write("mixed.pcd", b.data));
@@ -443,7 +453,8 @@ TEST_F(CloudIoTest, PcdErrors) {
                     "line 9: PCD DATA binary_compressed is not supported");
   EXPECT_READ_ERROR(write("datatype.pcd", fields + "POINTS 5\nDATA hex\n"), "line 9: unknown PCD DATA type 'hex'");
   EXPECT_READ_ERROR(write("nodata.pcd", fields + "POINTS 5\n"), "line 8: truncated PCD header (no DATA line)");
-  EXPECT_READ_ERROR(write("notpcd.pcd", "ply\nformat ascii 1.0\n"), "line 1: not a PCD file (unknown header keyword 'ply')");
+  EXPECT_READ_ERROR(write("notpcd.pcd", "ply\nformat ascii 1.0\n"),
+                    "line 1: not a PCD file (unknown header keyword 'ply')");
   EXPECT_READ_ERROR(write("keyword.pcd", "VERSION 0.7\nFEILDS x y z\n"), "line 2: unknown PCD header keyword 'FEILDS'");
   EXPECT_READ_ERROR(write("size.pcd", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n0 0 0\n"),
                     "line 2: SIZE has 2 entries but FIELDS has 3");
@@ -456,8 +467,10 @@ TEST_F(CloudIoTest, PcdErrors) {
   EXPECT_READ_ERROR(write("viewpoint.pcd", "FIELDS x y z\nVIEWPOINT 0 0 0 1 0 0\n"), "line 2: malformed VIEWPOINT");
   EXPECT_READ_ERROR(write("width.pcd", "FIELDS x y z\nWIDTH -5\n"), "line 2: malformed WIDTH line");
 
-  EXPECT_READ_ERROR(write("values.pcd", fields + "POINTS 2\nDATA ascii\n1 2 3\n1 2\n"), "line 11: expected 3 values, got 2");
-  EXPECT_READ_ERROR(write("nonnum.pcd", fields + "POINTS 2\nDATA ascii\n1 2 3\n1 2 x\n"), "line 11: non-numeric value 'x'");
+  EXPECT_READ_ERROR(write("values.pcd", fields + "POINTS 2\nDATA ascii\n1 2 3\n1 2\n"),
+                    "line 11: expected 3 values, got 2");
+  EXPECT_READ_ERROR(write("nonnum.pcd", fields + "POINTS 2\nDATA ascii\n1 2 3\n1 2 x\n"),
+                    "line 11: non-numeric value 'x'");
   EXPECT_READ_ERROR(write("truncascii.pcd", fields + "POINTS 5\nDATA ascii\n1 2 3\n"),
                     "line 11: truncated data (expected 5 points, got 1)");
   EXPECT_READ_ERROR(write("zero.pcd", fields + "POINTS 0\nDATA ascii\n"), "no points");
@@ -517,7 +530,8 @@ TEST_F(CloudIoTest, TextNaNPointsAreDroppedWithWarning) {
 }
 
 TEST_F(CloudIoTest, TextErrors) {
-  EXPECT_READ_ERROR(write("pts.xyz", "# a\n1 2 3\n\n4 5 6\n# b\n7 8 9\n1.5abc 2 3\n"), "line 7: non-numeric value '1.5abc'");
+  EXPECT_READ_ERROR(write("pts.xyz", "# a\n1 2 3\n\n4 5 6\n# b\n7 8 9\n1.5abc 2 3\n"),
+                    "line 7: non-numeric value '1.5abc'");
   EXPECT_READ_ERROR(write("x.xyz", "1 2 3\n1 2 3\n1 2 3\ninf 2 3\n"), "line 4: infinite coordinate 'inf'");
   EXPECT_READ_ERROR(write("two.xyz", "1 2 3\n1 2\n"), "line 2: expected at least 3 values, got 2");
   EXPECT_READ_ERROR(write("four.xyz", "1 2 3 4\n1 2 3\n"), "line 2: expected at least 4 values, got 3");

@@ -39,10 +39,10 @@ void expectFileError(const std::function<void()>& f, const std::string& prefix, 
 }
 
 // readMesh(path) must fail with "<path>: ..." containing every part.
-#define EXPECT_READ_ERROR(path, ...)                                                     \
-  do {                                                                                   \
-    SCOPED_TRACE("readMesh(" + std::string(path) + ")");                                 \
-    const std::string p_ = (path);                                                       \
+#define EXPECT_READ_ERROR(path, ...)                                                          \
+  do {                                                                                        \
+    SCOPED_TRACE("readMesh(" + std::string(path) + ")");                                      \
+    const std::string p_ = (path);                                                            \
     expectFileError([&] { readMesh(p_); }, p_ + ": ", std::vector<std::string>{__VA_ARGS__}); \
   } while (0)
 
@@ -110,7 +110,8 @@ class MeshIoTest : public ::testing::Test {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::string name = std::string(info->test_suite_name()) + "_" + info->name();
-    std::replace_if(name.begin(), name.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
+    std::replace_if(
+        name.begin(), name.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
     const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
     dir_ = fs::temp_directory_path() /
            ("sailshape_" + name + "_" + std::to_string(stamp) + "_" + std::to_string(counter++));
@@ -167,7 +168,9 @@ INSTANTIATE_TEST_SUITE_P(AllFormats, MeshRoundTrip,
                                            MeshFormatCase{MeshFormat::Obj, "m.obj", false},
                                            MeshFormatCase{MeshFormat::StlAscii, "m.stl", true},
                                            MeshFormatCase{MeshFormat::StlBinary, "m.stl", true}),
-                         [](const auto& info) { return std::to_string(info.index) + "_" + std::string(info.param.file).substr(2); });
+                         [](const auto& info) {
+                           return std::to_string(info.index) + "_" + std::string(info.param.file).substr(2);
+                         });
 
 TEST_F(MeshIoTest, AutoFormatFollowsExtension) {
   const Mesh mesh = makeSailPanel();
@@ -206,12 +209,12 @@ TEST_F(MeshIoTest, MissingFileAndUnknownExtension) {
 // PLY
 
 TEST_F(MeshIoTest, PlyAsciiFacesFirstWithQuadAndExtraProperties) {
-  const Mesh mesh = readMesh(write(
-      "quad.ply",
-      "ply\nformat ascii 1.0\ncomment faces before vertices\nelement face 2\nproperty uchar red\n"
-      "property list uint8 uint32 vertex_indices\nelement vertex 5\nproperty float x\nproperty float y\n"
-      "property float z\nproperty list uchar float texcoord\nend_header\n"
-      "255 4 0 1 2 3\n0 3 2 1 4\n0 0 0 2 0.1 0.2\n1 0 0 0\n1 1 0 0\n0 1 0 0\n0.5 0.5 1 0\n"));
+  const Mesh mesh =
+      readMesh(write("quad.ply",
+                     "ply\nformat ascii 1.0\ncomment faces before vertices\nelement face 2\nproperty uchar red\n"
+                     "property list uint8 uint32 vertex_indices\nelement vertex 5\nproperty float x\nproperty float y\n"
+                     "property float z\nproperty list uchar float texcoord\nend_header\n"
+                     "255 4 0 1 2 3\n0 3 2 1 4\n0 0 0 2 0.1 0.2\n1 0 0 0\n1 1 0 0\n0 1 0 0\n0.5 0.5 1 0\n"));
   ASSERT_EQ(mesh.vertices.size(), 5u);
   EXPECT_EQ(mesh.vertices[4], Vec3(0.5, 0.5, 1));
   ASSERT_EQ(mesh.triangles.size(), 3u);
@@ -223,9 +226,10 @@ TEST_F(MeshIoTest, PlyAsciiFacesFirstWithQuadAndExtraProperties) {
 
 TEST_F(MeshIoTest, PlyBinaryBigEndianWithVertexIndexName) {
   Bytes b;
-  b.text("ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
-         "property double z\nproperty uchar flags\nelement face 1\nproperty list uchar uint vertex_index\n"
-         "element material 1\nproperty float shine\nend_header\n");
+  b.text(
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+      "property double z\nproperty uchar flags\nelement face 1\nproperty list uchar uint vertex_index\n"
+      "element material 1\nproperty float shine\nend_header\n");
   b.be(0.0).be(0.0).be(0.0).be(uint8_t{1});
   b.be(2.0).be(0.0).be(0.0).be(uint8_t{1});
   b.be(0.0).be(3.0).be(1e-9).be(uint8_t{1});
@@ -274,8 +278,8 @@ TEST_F(MeshIoTest, PlyErrors) {
   for (int i = 0; i < 9; ++i) range.le(static_cast<float>(i));
   range.le(uint8_t{3}).le(int32_t{0}).le(int32_t{1}).le(int32_t{2});
   range.le(uint8_t{3}).le(int32_t{0}).le(int32_t{7}).le(int32_t{2});
-  EXPECT_READ_ERROR(write("range_bin.ply", range.data),
-                    "byte " + std::to_string(binary_header.size() + 36 + 13 + 5) + ": vertex index 7 out of range (3 vertices)");
+  EXPECT_READ_ERROR(write("range_bin.ply", range.data), "byte " + std::to_string(binary_header.size() + 36 + 13 + 5) +
+                                                            ": vertex index 7 out of range (3 vertices)");
 
   Bytes trunc;
   trunc.text(binary_header);
@@ -288,18 +292,19 @@ TEST_F(MeshIoTest, PlyErrors) {
   Bytes inf;
   inf.text(binary_header);
   for (int i = 0; i < 9; ++i) inf.le(i == 4 ? std::numeric_limits<float>::infinity() : 1.f);
-  EXPECT_READ_ERROR(write("inf_bin.ply", inf.data),
-                    "byte " + std::to_string(binary_header.size() + 16) + ": non-finite vertex coordinate (y of vertex 1)");
+  EXPECT_READ_ERROR(write("inf_bin.ply", inf.data), "byte " + std::to_string(binary_header.size() + 16) +
+                                                        ": non-finite vertex coordinate (y of vertex 1)");
 }
 
 // ---------------------------------------------------------------------------
 // OBJ
 
 TEST_F(MeshIoTest, ObjCornerFormsNegativeIndicesAndPolygons) {
-  const Mesh mesh = readMesh(write("forms.obj",
-                                   "# exported\nmtllib sail.mtl\no jib\nv 0 0 0\nv 1 0 0\nv 1 1 0 1.0\nv 0 1 0 0.5 0.5 0.5\n"
-                                   "vt 0 0\nvn 0 0 1\ng panel\nusemtl cloth\ns off\n"
-                                   "f 1/1/1 2/1/1 3/1/1 4/1/1\nf -4//1 -3 -2/1\nl 1 2\n\nf 1 3 5\nv 0.5 0.5 1\n"));
+  const Mesh mesh =
+      readMesh(write("forms.obj",
+                     "# exported\nmtllib sail.mtl\no jib\nv 0 0 0\nv 1 0 0\nv 1 1 0 1.0\nv 0 1 0 0.5 0.5 0.5\n"
+                     "vt 0 0\nvn 0 0 1\ng panel\nusemtl cloth\ns off\n"
+                     "f 1/1/1 2/1/1 3/1/1 4/1/1\nf -4//1 -3 -2/1\nl 1 2\n\nf 1 3 5\nv 0.5 0.5 1\n"));
   ASSERT_EQ(mesh.vertices.size(), 5u);
   ASSERT_EQ(mesh.triangles.size(), 4u);
   EXPECT_EQ(mesh.triangles[0], (std::array<uint32_t, 3>{0, 1, 2}));
@@ -311,14 +316,16 @@ TEST_F(MeshIoTest, ObjCornerFormsNegativeIndicesAndPolygons) {
 TEST_F(MeshIoTest, ObjErrors) {
   const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\n";
   EXPECT_READ_ERROR(write("range.obj", square + "f 1 2 4\n"), "line 4: vertex index 4 out of range (3 vertices)");
-  EXPECT_READ_ERROR(write("negative.obj", square + "f -1 -2 -4\n"), "line 4: vertex index -4 out of range (3 vertices)");
+  EXPECT_READ_ERROR(write("negative.obj", square + "f -1 -2 -4\n"),
+                    "line 4: vertex index -4 out of range (3 vertices)");
   EXPECT_READ_ERROR(write("zero.obj", square + "f 0 1 2\n"), "line 4: vertex index 0 (OBJ indices start at 1)");
   EXPECT_READ_ERROR(write("bad.obj", square + "f 1 2 x/1\n"), "line 4: invalid vertex index 'x/1'");
   EXPECT_READ_ERROR(write("two.obj", square + "f 1 2\n"), "line 4: face with 2 vertices (need at least 3)");
   EXPECT_READ_ERROR(write("coords.obj", "v 0 0\n"), "line 1: expected 3 coordinates, got 2");
   EXPECT_READ_ERROR(write("abc.obj", "v 0 0 0\nv 0 abc 0\n"), "line 2: non-numeric value 'abc'");
   EXPECT_READ_ERROR(write("inf.obj", "v 0 0 inf\n"), "line 1: non-finite vertex coordinate 'inf'");
-  EXPECT_READ_ERROR(write("forward.obj", square + "f 1 2 5\nv 2 2 2\n"), "line 4: vertex index 5 out of range (4 vertices)");
+  EXPECT_READ_ERROR(write("forward.obj", square + "f 1 2 5\nv 2 2 2\n"),
+                    "line 4: vertex index 5 out of range (4 vertices)");
   EXPECT_READ_ERROR(write("points.obj", square), "no triangles");
 }
 
