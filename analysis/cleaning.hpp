@@ -20,7 +20,7 @@ struct Cleaning {
 // mean + std_ratio · standard deviation of that distance over the cloud.
 struct StatisticalOutlierParams {
   int k_neighbours = 20;
-  double std_ratio = 3.0;
+  double std_ratio = 5.0;
 };
 Cleaning removeStatisticalOutliers(const Cloud& cloud, const StatisticalOutlierParams& params = {},
                                    const Progress& progress = {});

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "analysis/errors.hpp"
@@ -30,16 +31,74 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, 
 
 namespace {
 
-// Every key of `doc` must exist in `reference` (the defaults), recursively.
-void checkKeys(const nlohmann::json& doc, const nlohmann::json& reference, const std::string& prefix) {
+// Whether `value` can stand for a parameter whose default is `reference`: the same
+// JSON kind, and for counts a whole number in range (nlohmann would silently truncate
+// 20.5 to 20 and wrap −1 to 2^64 − 1). An empty default array says nothing about its
+// elements: `probe` tries the value in the defaults document instead.
+bool fits(const nlohmann::json& value, const nlohmann::json& reference, const std::function<bool()>& probe) {
+  using Kind = nlohmann::json::value_t;
+  switch (reference.type()) {
+    case Kind::number_float:
+      return value.is_number();
+    case Kind::number_integer:
+      return value.is_number_integer();
+    case Kind::number_unsigned:
+      return value.is_number_unsigned() || (value.is_number_integer() && value.get<long long>() >= 0);
+    case Kind::array:
+      if (!value.is_array()) return false;
+      if (reference.empty()) return probe();
+      for (const auto& v : value)
+        if (!fits(v, reference.front(), probe)) return false;
+      return true;
+    default:
+      return value.type() == reference.type();
+  }
+}
+
+// "number", "integer", ... for the message "must be a number".
+std::string kindName(const nlohmann::json& reference) {
+  switch (reference.type()) {
+    case nlohmann::json::value_t::number_float: return "number";
+    case nlohmann::json::value_t::number_integer: return "integer";
+    case nlohmann::json::value_t::number_unsigned: return "non-negative integer";
+    case nlohmann::json::value_t::boolean: return "boolean";
+    case nlohmann::json::value_t::array:
+      return reference.empty() ? "array of the right values" : "array of " + kindName(reference.front()) + "s";
+    default: return reference.type_name();
+  }
+}
+
+std::string withArticle(const std::string& noun) {
+  return (noun.find_first_of("aeiou") == 0 ? "an " : "a ") + noun;
+}
+
+// Every key of `doc` must exist in `reference` (the defaults), recursively, with a value
+// of the default's kind. `root` is the whole defaults document, `pointer` where doc sits in it.
+void checkKeys(const nlohmann::json& doc, const nlohmann::json& reference, const std::string& prefix,
+               const nlohmann::json::json_pointer& pointer, const nlohmann::json& root) {
   if (!doc.is_object()) return;
   for (auto it = doc.begin(); it != doc.end(); ++it) {
     const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
     if (!reference.contains(it.key())) throw InvalidInput("[paramsFromJson] unknown parameter '" + key + "'");
-    if (reference[it.key()].is_object()) {
+    const nlohmann::json& ref = reference[it.key()];
+    if (ref.is_object()) {
       if (!it.value().is_object()) throw InvalidInput("[paramsFromJson] parameter '" + key + "' must be an object");
-      checkKeys(it.value(), reference[it.key()], key);
+      checkKeys(it.value(), ref, key, pointer / it.key(), root);
+      continue;
     }
+    auto probe = [&] {
+      nlohmann::json trial = root;
+      trial[pointer / it.key()] = it.value();
+      try {
+        (void)trial.get<AnalysisParams>();
+        return true;
+      } catch (const nlohmann::json::exception&) {
+        return false;
+      }
+    };
+    if (!fits(it.value(), ref, probe))
+      throw InvalidInput("[paramsFromJson] parameter '" + key + "' must be " + withArticle(kindName(ref)) + " (got " +
+                         it.value().dump() + ")");
   }
 }
 
@@ -85,7 +144,8 @@ nlohmann::json paramsToJson(const AnalysisParams& params) { return params; }
 
 AnalysisParams paramsFromJson(const nlohmann::json& doc) {
   if (!doc.is_object()) throw InvalidInput("[paramsFromJson] the parameter document must be an object");
-  checkKeys(doc, paramsToJson(AnalysisParams{}), "");
+  const nlohmann::json defaults = paramsToJson(AnalysisParams{});
+  checkKeys(doc, defaults, "", nlohmann::json::json_pointer(), defaults);
   try {
     return doc.get<AnalysisParams>();
   } catch (const nlohmann::json::exception& e) {

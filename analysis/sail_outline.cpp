@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <unordered_map>
 #include <unordered_set>
@@ -85,24 +86,6 @@ Vec3 loopPointAt(const std::vector<Vec3>& pts, const std::vector<double>& cum, d
   return pts[i] + t * (pts[j] - pts[i]);
 }
 
-// Uniformly resampled and moving-average smoothed polyline; ends stay fixed.
-std::vector<Vec3> smoothPolyline(const std::vector<Vec3>& line, double step, double window) {
-  const double len = polylineLength(line);
-  if (line.size() < 2 || len <= 0) return line;
-  const size_t n = std::max<size_t>(2, static_cast<size_t>(std::ceil(len / std::max(step, 1e-6))) + 1);
-  std::vector<Vec3> uniform(n);
-  for (size_t i = 0; i < n; ++i) uniform[i] = pointAtFraction(line, static_cast<double>(i) / (n - 1));
-  const size_t half = static_cast<size_t>(std::round(0.5 * window / (len / (n - 1))));
-  std::vector<Vec3> out(n);
-  for (size_t i = 0; i < n; ++i) {
-    const size_t h = std::min({half, i, n - 1 - i});  // symmetric window keeps the ends in place
-    Vec3 sum = Vec3::Zero();
-    for (size_t j = i - h; j <= i + h; ++j) sum += uniform[j];
-    out[i] = sum / static_cast<double>(2 * h + 1);
-  }
-  return out;
-}
-
 // Area-weighted vertex normals.
 std::vector<Vec3> vertexNormals(const Mesh& mesh) {
   std::vector<Vec3> n(mesh.vertices.size(), Vec3::Zero());
@@ -115,86 +98,192 @@ std::vector<Vec3> vertexNormals(const Mesh& mesh) {
   return n;
 }
 
+// A smooth edge: P(s) = Σ_k c_k u^k with u = (s − mid) / half, s in metres of
+// boundary arc from the edge's first corner. Fitted by least squares.
+struct EdgeCurve {
+  Eigen::MatrixXd coeffs;  // (degree + 1) × 3
+  double mid = 0, half = 1;
+
+  Vec3 at(double s) const {
+    const double u = (s - mid) / half;
+    Vec3 p = Vec3::Zero();
+    double uk = 1;
+    for (Eigen::Index k = 0; k < coeffs.rows(); ++k, uk *= u) p += uk * coeffs.row(k).transpose();
+    return p;
+  }
+  Vec3 tangent(double s) const {
+    const double h = 1e-4 * half;
+    return (at(s + h) - at(s - h)).normalized();
+  }
+};
+
+EdgeCurve fitEdgeCurve(const std::vector<Vec3>& pts, const std::vector<double>& s, int degree) {
+  EdgeCurve c;
+  const double lo = *std::min_element(s.begin(), s.end()), hi = *std::max_element(s.begin(), s.end());
+  c.mid = 0.5 * (lo + hi);
+  c.half = std::max(1e-9, 0.5 * (hi - lo));
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(pts.size()), degree + 1);
+  Eigen::MatrixXd B(static_cast<Eigen::Index>(pts.size()), 3);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const double u = (s[i] - c.mid) / c.half;
+    double uk = 1;
+    for (int k = 0; k <= degree; ++k, uk *= u) A(static_cast<Eigen::Index>(i), k) = uk;
+    B.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
+  }
+  c.coeffs = A.colPivHouseholderQr().solve(B);
+  return c;
+}
+
+// One sail edge as found on the boundary: its points from corner to corner
+// with their arc positions, moved out to the true edge, and the fitted curve.
+struct Edge {
+  std::vector<Vec3> points;   // boundary points moved out by `recess`
+  std::vector<double> s;      // arc position of each point from the first corner, metres
+  double length = 0;
+  double exclude = 0;         // arc near each corner left out of the curve fit (corners are rounded off)
+  EdgeCurve curve;            // fitted on [exclude, length − exclude]
+  double recess = 0;          // how far the sampled boundary lies inside the true edge
+};
+
 // A sampled surface's boundary lies inside the true edge: the outermost samples
 // sit some distance in. Sample offsets from the true edge are uniform on
-// [0, ∞), so within the strip s ≤ D of the found edge (offset s from it,
-// positive inwards) they are uniform on [−δ, D] and δ = D − 2·mean(s).
-// Returns the edge moved out by δ, and δ.
-std::pair<std::vector<Vec3>, double> pushEdgeOut(const std::vector<Vec3>& edge, const Mesh& mesh,
-                                                 const std::vector<Vec3>& normals, const KdTree& vertex_tree,
-                                                 double spacing) {
-  const double strip = 4.0 * spacing;
-  const size_t n = edge.size();
-  if (n < 5) return {edge, 0.0};
-  std::vector<Vec3> inward(n);
+// [0, ∞), so within the strip o ≤ D of the found edge (offset o from it,
+// positive inwards) they are uniform on [−δ, D] and δ = D − 2·mean(o).
+// The edge's points are moved out by δ and the curve is fitted again.
+void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const KdTree& tree, double spacing) {
+  e.length = e.s.back();
+  e.exclude = std::max(0.03 * e.length, 6.0 * spacing);
+  std::vector<size_t> inner;
+  for (size_t i = 0; i < e.points.size(); ++i)
+    if (e.s[i] >= e.exclude && e.s[i] <= e.length - e.exclude) inner.push_back(i);
+  if (inner.size() < 6) {  // a very short edge: keep every point
+    inner.clear();
+    for (size_t i = 0; i < e.points.size(); ++i) inner.push_back(i);
+    e.exclude = 0;
+  }
+  const int degree = static_cast<int>(std::clamp<size_t>(inner.size() / 8, 1, 5));
+  auto fit = [&] {
+    std::vector<Vec3> pts;
+    std::vector<double> s;
+    for (size_t i : inner) {
+      pts.push_back(e.points[i]);
+      s.push_back(e.s[i]);
+    }
+    e.curve = fitEdgeCurve(pts, s, degree);
+  };
+  fit();
+
+  // Inward direction at each point: surface normal × tangent, towards the mesh.
   std::vector<uint32_t> idx;
   std::vector<double> d2;
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3 t = (edge[std::min(i + 1, n - 1)] - edge[i > 0 ? i - 1 : 0]).normalized();
-    vertex_tree.nearest(edge[i], 8, idx, d2);
-    Vec3 normal = Vec3::Zero();
-    Vec3 centre = Vec3::Zero();
+  std::vector<Vec3> inward(e.points.size());
+  for (size_t i = 0; i < e.points.size(); ++i) {
+    const double si = std::clamp(e.s[i], e.exclude, e.length - e.exclude);
+    const Vec3 c = e.curve.at(si);
+    tree.nearest(e.points[i], 24, idx, d2);
+    Vec3 n = Vec3::Zero(), centre = Vec3::Zero();
     for (uint32_t v : idx) {
-      normal += normals[v];
+      n += normals[v];
       centre += mesh.vertices[v];
     }
     centre /= static_cast<double>(idx.size());
-    Vec3 in = normal.normalized().cross(t);
-    if (in.dot(centre - edge[i]) < 0) in = -in;  // the vertex cloud lies inwards
+    Vec3 in = n.normalized().cross(e.curve.tangent(si));
+    if (in.dot(centre - c) < 0) in = -in;
     inward[i] = in;
   }
-  // Offsets of the vertices near the middle 90 % of the edge (corners excluded).
+  const double strip = 4.0 * spacing;
   double sum = 0;
   size_t count = 0;
-  const size_t lo = n / 20, hi = n - 1 - n / 20;
-  for (size_t i = lo; i <= hi; ++i) {
-    vertex_tree.withinRadius(edge[i], strip, idx, d2);
+  std::vector<char> seen(mesh.vertices.size(), 0);
+  for (size_t k = 0; k < inner.size(); k += 2) {
+    const size_t i = inner[k];
+    const Vec3 c = e.curve.at(e.s[i]);
+    const Vec3 t = e.curve.tangent(e.s[i]);
+    tree.withinRadius(c, strip, idx, d2);
     for (uint32_t v : idx) {
-      const Vec3 d = mesh.vertices[v] - edge[i];
-      const Vec3 t = (edge[std::min(i + 1, n - 1)] - edge[i > 0 ? i - 1 : 0]).normalized();
-      const double along = d.dot(t);
-      if (std::abs(along) > 0.5 * (edge[std::min(i + 1, n - 1)] - edge[i]).norm()) continue;  // nearest sample only
-      const double s = d.dot(inward[i]);
-      if (s > strip) continue;
-      sum += s;
+      if (seen[v]) continue;
+      const Vec3 d = mesh.vertices[v] - c;
+      if (std::abs(d.dot(t)) > spacing) continue;  // belongs to a neighbouring sample
+      seen[v] = 1;
+      const double o = d.dot(inward[i]);
+      if (o > strip) continue;
+      sum += o;
       ++count;
     }
   }
-  if (count < 30) return {edge, 0.0};
-  const double delta = std::clamp(strip - 2.0 * sum / static_cast<double>(count), 0.0, strip);
-  std::vector<Vec3> moved(n);
-  for (size_t i = 0; i < n; ++i) moved[i] = edge[i] - delta * inward[i];
-  return {moved, delta};
+  if (count >= 30) e.recess = std::clamp(strip - 2.0 * sum / static_cast<double>(count), 0.0, strip);
+  if (e.recess > 0) {
+    for (size_t i = 0; i < e.points.size(); ++i) e.points[i] -= e.recess * inward[i];
+    fit();
+  }
 }
 
-// Closest point between the lines fitted to two edges near their common corner
-// (edges start at the corner), fitted over arc range [near, far].
-Vec3 extrapolateCorner(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double near, double far) {
-  auto fit = [&](const std::vector<Vec3>& e, Vec3& point, Vec3& dir) {
-    std::vector<Vec3> pts;
-    double s = 0;
-    for (size_t i = 1; i < e.size(); ++i) {
-      s += (e[i] - e[i - 1]).norm();
-      if (s >= near && s <= far) pts.push_back(e[i]);
+// A quadratic through an edge's points near one of its corners, as a function
+// of the arc distance d from that corner (the rounded-off tip left out).
+EdgeCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree) {
+  const double skip = 3.0 * spacing, reach = std::max(60.0 * spacing, 0.05 * e.length);
+  std::vector<Vec3> pts;
+  std::vector<double> d;
+  for (size_t i = 0; i < e.points.size(); ++i) {
+    const double di = at_start ? e.s[i] : e.length - e.s[i];
+    if (di >= skip && di <= skip + reach) {
+      pts.push_back(e.points[i]);
+      d.push_back(di);
     }
-    if (pts.size() < 3) return false;
-    point = Vec3::Zero();
-    for (const Vec3& p : pts) point += p;
-    point /= static_cast<double>(pts.size());
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const Vec3& p : pts) cov += (p - point) * (p - point).transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    dir = eig.eigenvectors().col(2);
-    return true;
-  };
-  Vec3 pa, da, pb, db;
-  if (!fit(a, pa, da) || !fit(b, pb, db)) return a.front();
-  const Vec3 w = pa - pb;
-  const double A = da.dot(da), B = da.dot(db), C = db.dot(db), D = da.dot(w), E = db.dot(w);
-  const double den = A * C - B * B;
-  if (den < 1e-6) return a.front();  // edges nearly parallel: no defined corner
-  const double sa = (B * E - C * D) / den, sb = (A * E - B * D) / den;
-  return 0.5 * ((pa + sa * da) + (pb + sb * db));
+  }
+  if (pts.size() < 6) {  // short edge: all of it
+    pts.clear();
+    d.clear();
+    for (size_t i = 0; i < e.points.size(); ++i) {
+      pts.push_back(e.points[i]);
+      d.push_back(at_start ? e.s[i] : e.length - e.s[i]);
+    }
+  }
+  return fitEdgeCurve(pts, d, pts.size() >= 12 ? degree : 1);
+}
+
+// Where two edges meet: the closest pair of points of their corner curves
+// (both parametrised by distance from the corner, extrapolated back to it).
+// Quadratics follow edges that curve into a corner; at a sharp corner the
+// meeting point of nearly parallel curves is ill-conditioned along the
+// bisector, so straight lines are used there (below 45°).
+Vec3 meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing) {
+  EdgeCurve ca = cornerCurve(a, a_start, spacing, 1), cb = cornerCurve(b, b_start, spacing, 1);
+  const Vec3 da = ca.at(1) - ca.at(0), db = cb.at(1) - cb.at(0);
+  const double angle = std::acos(std::clamp(da.normalized().dot(db.normalized()), -1.0, 1.0)) * 180.0 / kPi;
+  if (angle >= 45.0) {
+    ca = cornerCurve(a, a_start, spacing, 2);
+    cb = cornerCurve(b, b_start, spacing, 2);
+  }
+  const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
+  double best = std::numeric_limits<double>::infinity(), sa = 0, sb = 0;
+  double r = range;
+  for (int level = 0; level < 6; ++level) {
+    const double ma = sa, mb = sb;
+    for (int i = -10; i <= 10; ++i)
+      for (int j = -10; j <= 10; ++j) {
+        const double ta = ma + r * i / 10.0, tb = mb + r * j / 10.0;
+        const double dd = (ca.at(ta) - cb.at(tb)).squaredNorm();
+        if (dd < best) {
+          best = dd;
+          sa = ta;
+          sb = tb;
+        }
+      }
+    r /= 5.0;
+  }
+  return 0.5 * (ca.at(sa) + cb.at(sb));
+}
+
+// The edge from corner to corner: the fitted curve between the excluded ends.
+std::vector<Vec3> edgePolyline(const Edge& e, const Vec3& first, const Vec3& last, double step) {
+  std::vector<Vec3> out{first};
+  const double from = e.exclude, to = e.length - e.exclude;
+  const size_t n = std::max<size_t>(2, static_cast<size_t>(std::ceil((to - from) / std::max(step, 1e-6))) + 1);
+  for (size_t i = 0; i < n; ++i)
+    out.push_back(e.curve.at(from + (to - from) * static_cast<double>(i) / static_cast<double>(n - 1)));
+  out.push_back(last);
+  return out;
 }
 
 }  // namespace
@@ -327,50 +416,41 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
     }
     throw AnalysisError("[extractOutline] corners are not in sail order along the boundary");
   };
-  const double step = out.boundary_spacing_m;
-  const double window = p.edge_smoothing_m > 0 ? p.edge_smoothing_m : 0.006 * total;
-  out.luff = smoothPolyline(edge(tack, head), step, window);
-  out.foot = smoothPolyline(edge(tack, clew), step, window);
-  out.leech = smoothPolyline(edge(clew, out.has_peak ? peak : head), step, window);
-  if (out.has_peak) out.top = smoothPolyline(edge(head, peak), step, window);
-
-  // Move each edge out to where the surface really ends, then place the corners
-  // where neighbouring edges meet (a sharp corner itself is never sampled).
+  // Fit each edge, move it out to where the surface really ends, and place the
+  // corners where neighbouring edges meet (a sharp corner itself is never sampled).
   const std::vector<Vec3> normals = vertexNormals(mesh);
   const KdTree tree(mesh.vertices);
-  double area_outside = 0;
-  for (std::vector<Vec3>* e : {&out.luff, &out.foot, &out.leech, &out.top}) {
-    if (e->empty()) continue;
-    auto [moved, delta] = pushEdgeOut(*e, mesh, normals, tree, out.boundary_spacing_m);
-    area_outside += delta * polylineLength(*e);
-    *e = smoothPolyline(moved, step, window);  // per-sample inward directions are noisy
-  }
-  auto reversed = [](std::vector<Vec3> v) {
-    std::reverse(v.begin(), v.end());
-    return v;
+  auto makeEdge = [&](size_t from, size_t to) {
+    Edge e;
+    e.points = edge(from, to);
+    e.s.assign(e.points.size(), 0.0);
+    for (size_t i = 1; i < e.points.size(); ++i) e.s[i] = e.s[i - 1] + (e.points[i] - e.points[i - 1]).norm();
+    fitEdge(e, mesh, normals, tree, out.boundary_spacing_m);
+    return e;
   };
-  const double near = 0.5 * w, far = 2.5 * w;
-  out.tack = extrapolateCorner(out.luff, out.foot, near, far);
-  out.clew = extrapolateCorner(out.leech, reversed(out.foot), near, far);
+  const Edge luff = makeEdge(tack, head), foot = makeEdge(tack, clew);
+  const Edge leech = makeEdge(clew, out.has_peak ? peak : head);
+  Edge top;
+  if (out.has_peak) top = makeEdge(head, peak);
+  const double sp = out.boundary_spacing_m;
+  out.tack = meetEdges(luff, true, foot, true, sp);
+  out.clew = meetEdges(foot, false, leech, true, sp);
   if (out.has_peak) {
-    out.head = extrapolateCorner(reversed(out.luff), out.top, near, far);
-    out.peak = extrapolateCorner(reversed(out.leech), reversed(out.top), near, far);
-    out.top.front() = out.head;
-    out.top.back() = out.peak;
-    out.leech.back() = out.peak;
+    out.head = meetEdges(luff, false, top, true, sp);
+    out.peak = meetEdges(leech, false, top, false, sp);
   } else {
-    out.head = extrapolateCorner(reversed(out.luff), reversed(out.leech), near, far);
-    out.leech.back() = out.head;
+    out.head = meetEdges(luff, false, leech, false, sp);
   }
-  out.luff.front() = out.tack;
-  out.luff.back() = out.head;
-  out.foot.front() = out.tack;
-  out.foot.back() = out.clew;
-  out.leech.front() = out.clew;
+  out.luff = edgePolyline(luff, out.tack, out.head, sp);
+  out.foot = edgePolyline(foot, out.tack, out.clew, sp);
+  out.leech = edgePolyline(leech, out.clew, out.has_peak ? out.peak : out.head, sp);
+  if (out.has_peak) out.top = edgePolyline(top, out.head, out.peak, sp);
   out.luff_length_m = polylineLength(out.luff);
   out.leech_length_m = polylineLength(out.leech);
   out.foot_length_m = polylineLength(out.foot);
   out.top_length_m = polylineLength(out.top);
+  double area_outside = luff.recess * out.luff_length_m + foot.recess * out.foot_length_m +
+                        leech.recess * out.leech_length_m + top.recess * out.top_length_m;
   out.area_m2 = meshArea(mesh) + area_outside;
 
   if (!p.design_lengths_m.empty()) {

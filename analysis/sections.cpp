@@ -86,26 +86,43 @@ std::vector<Cut> cutMesh(const Mesh& mesh, const Vec3& q, const Vec3& m) {
   return cuts;
 }
 
-// The cut that runs from near the luff point to near the leech point, oriented luff → leech.
+// The section curve from luff to leech: the cut pieces that lie over the chord
+// (within half a chord of it, between its ends), joined in chord order. A cut
+// is normally one piece; holes or non-manifold edges can break it into several.
 bool pickCut(std::vector<Cut>& cuts, const Vec3& L, const Vec3& R, double chord, Cut& out) {
-  double best = std::numeric_limits<double>::infinity();
-  int best_i = -1;
-  for (size_t i = 0; i < cuts.size(); ++i) {
-    double dl = std::numeric_limits<double>::infinity(), dr = dl;
-    for (const Vec3& p : cuts[i].points) {
-      dl = std::min(dl, (p - L).norm());
-      dr = std::min(dr, (p - R).norm());
+  const Vec3 c_hat = (R - L) / chord;
+  struct Sample {
+    double x;
+    Vec3 p;
+    uint32_t tri;
+  };
+  std::vector<Sample> samples;
+  for (const Cut& cut : cuts) {
+    bool over_chord = false;
+    for (const Vec3& p : cut.points) {
+      const double x = (p - L).dot(c_hat);
+      const double off = (p - L - x * c_hat).norm();
+      if (x > -0.05 * chord && x < 1.05 * chord && off < 0.5 * chord) over_chord = true;
     }
-    if (dl + dr < best) {
-      best = dl + dr;
-      best_i = static_cast<int>(i);
+    if (!over_chord) continue;
+    for (size_t i = 0; i < cut.points.size(); ++i) {
+      const Vec3& p = cut.points[i];
+      const double x = (p - L).dot(c_hat);
+      if (x < -0.05 * chord || x > 1.05 * chord || (p - L - x * c_hat).norm() > 0.5 * chord) continue;
+      samples.push_back({x, p, cut.triangles[std::min(i, cut.triangles.size() - 1)]});
     }
   }
-  if (best_i < 0 || best > 0.2 * chord) return false;
-  out = std::move(cuts[static_cast<size_t>(best_i)]);
-  if ((out.points.front() - L).norm() > (out.points.back() - L).norm()) {
-    std::reverse(out.points.begin(), out.points.end());
-    std::reverse(out.triangles.begin(), out.triangles.end());
+  if (samples.size() < 3) return false;
+  std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.x < b.x; });
+  // The curve must span the chord without a large gap.
+  double gap = std::max(samples.front().x, chord - samples.back().x);
+  for (size_t i = 1; i < samples.size(); ++i) gap = std::max(gap, samples[i].x - samples[i - 1].x);
+  if (gap > 0.1 * chord) return false;
+  out.points.clear();
+  out.triangles.clear();
+  for (const Sample& s : samples) {
+    out.points.push_back(s.p);
+    out.triangles.push_back(s.tri);
   }
   return true;
 }
@@ -118,23 +135,29 @@ struct QuadFit {
 
 // Least-squares quadratic with the coefficients' covariance; `floor_sigma`
 // bounds the residual σ from below (a perfect fit still has sensor noise).
-QuadFit fitQuadratic(const std::vector<Eigen::Vector2d>& xy, double x0, double floor_sigma) {
+// `anchored` fixes c0 = 0: the curve passes through (x0, 0), as a section
+// passes through its own luff and leech points.
+QuadFit fitQuadratic(const std::vector<Eigen::Vector2d>& xy, double x0, double floor_sigma, bool anchored = false) {
   QuadFit f;
-  if (xy.size() < 4) return f;
-  Eigen::MatrixXd A(xy.size(), 3);
+  const int first = anchored ? 1 : 0, cols = 3 - first;
+  if (xy.size() < static_cast<size_t>(cols + 1)) return f;
+  Eigen::MatrixXd A(xy.size(), cols);
   Eigen::VectorXd y(xy.size());
   for (size_t i = 0; i < xy.size(); ++i) {
     const double u = xy[i].x() - x0;
-    A.row(static_cast<Eigen::Index>(i)) << 1, u, u * u;
+    const double basis[3] = {1, u, u * u};
+    for (int k = 0; k < cols; ++k) A(static_cast<Eigen::Index>(i), k) = basis[first + k];
     y[static_cast<Eigen::Index>(i)] = xy[i].y();
   }
-  const Eigen::Matrix3d AtA = A.transpose() * A;
-  Eigen::FullPivLU<Eigen::Matrix3d> lu(AtA);
+  const Eigen::MatrixXd AtA = A.transpose() * A;
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(AtA);
   if (!lu.isInvertible()) return f;
-  f.c = lu.solve(A.transpose() * y);
-  const double rss = (A * f.c - y).squaredNorm();
-  const double s2 = std::max(rss / static_cast<double>(xy.size() - 3), floor_sigma * floor_sigma);
-  f.cov = s2 * lu.inverse();
+  const Eigen::VectorXd c = lu.solve(A.transpose() * y);
+  const double rss = (A * c - y).squaredNorm();
+  const double s2 = std::max(rss / static_cast<double>(xy.size() - static_cast<size_t>(cols)), floor_sigma * floor_sigma);
+  const Eigen::MatrixXd cov = s2 * lu.inverse();
+  f.c.tail(cols) = c;
+  f.cov.bottomRightCorner(cols, cols) = cov;
   f.ok = true;
   return f;
 }
@@ -263,7 +286,7 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
       auto cuts = cutMesh(mesh, f.L, f.m);
       if (!pickCut(cuts, f.L, f.R, f.chord, cut))
         throw AnalysisError("[cutSections] the section plane at fraction " + std::to_string(t) +
-                            " does not cut the sail between luff and leech");
+                            " does not cut the sail between luff and leech (or leaves a gap over 10 % of the chord)");
     };
     cutAt(0);
     s.converged = true;

@@ -31,7 +31,7 @@ Segmentation clusterEuclidean(const Cloud& cloud, const EuclideanClusterParams& 
 // max_curvature. Regions outside [min_points, max_points] are left unassigned.
 struct RegionGrowingParams {
   int k_neighbours = 30;
-  double max_normal_angle_deg = 10.0;
+  double max_normal_angle_deg = 7.0;
   double max_curvature = 0.05;
   size_t min_points = 500;
   size_t max_points = 50'000'000;

@@ -87,12 +87,18 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
   if (p.projection != "auto" && p.projection != "plane" && p.projection != "scan_angles")
     throw InvalidInput("[reconstructSurface] projection must be auto, plane or scan_angles (got '" + p.projection +
                        "')");
-  if (p.max_edge_m < 0 || !(p.max_edge_factor > 0))
-    throw InvalidInput("[reconstructSurface] max_edge_m must be >= 0 and max_edge_factor > 0");
+  if (!(p.max_edge_m >= 0) || !(p.max_edge_factor > 0))
+    throw InvalidInput("[reconstructSurface] max_edge_m must be >= 0 and max_edge_factor > 0 (got " +
+                       std::to_string(p.max_edge_m) + " and " + std::to_string(p.max_edge_factor) + ")");
   Surface result;
   result.projection = p.projection == "auto" ? (cloud.hasScanAngles() ? "scan_angles" : "plane") : p.projection;
   if (result.projection == "scan_angles" && !cloud.hasScanAngles())
     throw InvalidInput("[reconstructSurface] projection scan_angles needs per-point alpha_rad and beta_rad");
+  if (result.projection == "scan_angles" &&
+      (cloud.alpha_rad.size() != cloud.size() || cloud.beta_rad.size() != cloud.size()))
+    throw InvalidInput("[reconstructSurface] projection scan_angles needs alpha_rad and beta_rad for every point (got " +
+                       std::to_string(cloud.alpha_rad.size()) + " alpha_rad, " + std::to_string(cloud.beta_rad.size()) +
+                       " beta_rad for " + std::to_string(cloud.size()) + " points)");
 
   auto projected = result.projection == "plane" ? projectToPlane(cloud) : projectToScanAngles(cloud);
   Delaunay dt;
@@ -104,6 +110,15 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
   std::vector<double> edge_len;
   edge_len.reserve(static_cast<size_t>(dt.number_of_faces()) * 3);
   for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
+    // Points that should be collinear (a straight boundary of a regular scan) come out of
+    // the projection a rounding error apart, and the triangulation joins them into
+    // zero-area slivers along the hull: no surface, no normal. Skip faces whose height is
+    // below 1e-9 of their longest edge.
+    const Kernel::Point_2 &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
+    const double twice_area = std::abs((b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x()));
+    const double longest2 = std::max({CGAL::squared_distance(a, b), CGAL::squared_distance(b, c),
+                                      CGAL::squared_distance(c, a)});
+    if (twice_area <= 1e-9 * longest2) continue;
     std::array<uint32_t, 3> t{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
     tris.push_back(t);
     for (int e = 0; e < 3; ++e) edge_len.push_back((cloud.points[t[e]] - cloud.points[t[(e + 1) % 3]]).norm());

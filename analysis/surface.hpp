@@ -25,7 +25,7 @@ struct Surface {
   std::vector<uint32_t> vertex_source;  // input index of each mesh vertex
   std::string projection;        // what was used
   double max_edge_m = 0;         // the threshold applied
-  size_t delaunay_triangles = 0;
+  size_t delaunay_triangles = 0;       // proper ones: zero-area slivers between collinear points are skipped
   size_t dropped_long_edges = 0;
   size_t dropped_small_components = 0;
   std::vector<std::string> warnings;
