@@ -328,20 +328,21 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
     std::nth_element(s.begin(), s.begin() + n / 2, s.end());
     out.boundary_spacing_m = s[n / 2];
   }
-  const double w = p.corner_window_m > 0 ? p.corner_window_m : 0.02 * total;
+  const double w = p.corner_window_m > 0 ? p.corner_window_m : 0.01 * total;
 
-  // Turning angle over arms of length w; at a corner it approaches the exterior angle.
-  std::vector<double> turn(n);
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3 a = pts[i] - loopPointAt(pts, cum, total, cum[i] - w);
-    const Vec3 b = loopPointAt(pts, cum, total, cum[i] + w) - pts[i];
+  // Turning angle over arms of length `arm`; at a corner it approaches the exterior angle.
+  auto turnAt = [&](size_t i, double arm) {
+    const Vec3 a = pts[i] - loopPointAt(pts, cum, total, cum[i] - arm);
+    const Vec3 b = loopPointAt(pts, cum, total, cum[i] + arm) - pts[i];
     const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
-    turn[i] = std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
-  }
+    return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
+  };
+  std::vector<double> turn(n);
+  for (size_t i = 0; i < n; ++i) turn[i] = turnAt(i, w);
   std::vector<size_t> order(n);
   for (size_t i = 0; i < n; ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return turn[a] > turn[b]; });
-  const double min_sep = std::max(3.0 * w, 0.05 * total);
+  const double min_sep = std::max(2.5 * w, 0.025 * total);
   auto arcDist = [&](size_t a, size_t b) {
     const double d = std::abs(cum[a] - cum[b]);
     return std::min(d, total - d);
@@ -356,7 +357,17 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   if (picked.size() < 3)
     throw AnalysisError("[extractOutline] the boundary (" + fmt(total, 2) + " m) has fewer than 3 distinct corners");
   size_t count = p.corners;
-  if (count == 0) count = (picked.size() == 4 && turn[picked[3]] >= p.min_fourth_corner_deg) ? 4 : 3;
+  if (count == 0) {
+    // A 4th corner must turn sharply and stand clear of the others: a square
+    // head is a real edge, not a kink beside the head of a triangular sail.
+    bool clear = picked.size() == 4;
+    for (size_t j = 0; clear && j < 3; ++j) clear = arcDist(picked[3], picked[j]) >= 4.0 * w;
+    // ... and keep turning at twice the scale (a local notch in a noisy edge does not).
+    count = clear && turn[picked[3]] >= p.min_fourth_corner_deg &&
+                    turnAt(picked[3], 2.0 * w) >= p.min_fourth_corner_deg
+                ? 4
+                : 3;
+  }
   if (picked.size() < count)
     throw AnalysisError("[extractOutline] asked for " + std::to_string(count) + " corners, found " +
                         std::to_string(picked.size()));

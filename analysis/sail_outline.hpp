@@ -12,7 +12,7 @@ namespace sailshape {
 
 struct OutlineParams {
   int corners = 0;                    // 0: auto (3, or 4 when a 4th turns enough), 3 or 4
-  double corner_window_m = 0.0;       // arm length for the turning angle; 0: 2 % of the boundary length
+  double corner_window_m = 0.0;       // arm length for the turning angle; 0: 1 % of the boundary length
   double min_fourth_corner_deg = 40;  // auto: a 4th corner needs at least this turning angle
   double edge_smoothing_m = 0.0;      // moving-average window along the edges; 0: 0.6 % of boundary length
   // Design lengths [luff, leech, foot] in metres to check against (empty: no check);
