@@ -243,18 +243,9 @@ EdgeCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree) 
 }
 
 // Where two edges meet: the closest pair of points of their corner curves
-// (both parametrised by distance from the corner, extrapolated back to it).
-// Quadratics follow edges that curve into a corner; at a sharp corner the
-// meeting point of nearly parallel curves is ill-conditioned along the
-// bisector, so straight lines are used there (below 45°).
+// (quadratics in the distance from the corner, extrapolated back to it).
 Vec3 meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing) {
-  EdgeCurve ca = cornerCurve(a, a_start, spacing, 1), cb = cornerCurve(b, b_start, spacing, 1);
-  const Vec3 da = ca.at(1) - ca.at(0), db = cb.at(1) - cb.at(0);
-  const double angle = std::acos(std::clamp(da.normalized().dot(db.normalized()), -1.0, 1.0)) * 180.0 / kPi;
-  if (angle >= 45.0) {
-    ca = cornerCurve(a, a_start, spacing, 2);
-    cb = cornerCurve(b, b_start, spacing, 2);
-  }
+  const EdgeCurve ca = cornerCurve(a, a_start, spacing, 2), cb = cornerCurve(b, b_start, spacing, 2);
   const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
   double best = std::numeric_limits<double>::infinity(), sa = 0, sb = 0;
   double r = range;

@@ -162,6 +162,72 @@ QuadFit fitQuadratic(const std::vector<Eigen::Vector2d>& xy, double x0, double f
   return f;
 }
 
+// Maximum of a cubic fitted around the deepest cut point: a cubic follows the
+// asymmetric crest of a real section (fuller forward than aft), so a wide
+// window can average the noise without biasing the draft. Returns false when
+// the fit has no maximum inside the window.
+struct Peak {
+  double x = 0, depth = 0, sd_x = 0, sd_depth = 0;
+};
+bool fitPeak(const std::vector<Eigen::Vector2d>& xy, double x0, double half_window, Peak& peak) {
+  if (xy.size() < 8) return false;
+  Eigen::MatrixXd A(xy.size(), 4);
+  Eigen::VectorXd y(xy.size());
+  for (size_t i = 0; i < xy.size(); ++i) {
+    const double u = (xy[i].x() - x0) / half_window;
+    A.row(static_cast<Eigen::Index>(i)) << 1, u, u * u, u * u * u;
+    y[static_cast<Eigen::Index>(i)] = xy[i].y();
+  }
+  const Eigen::Matrix4d AtA = A.transpose() * A;
+  Eigen::FullPivLU<Eigen::Matrix4d> lu(AtA);
+  if (!lu.isInvertible()) return false;
+  const Eigen::Vector4d c = lu.solve(A.transpose() * y);
+  const double s2 = (A * c - y).squaredNorm() / static_cast<double>(xy.size() - 4);
+  const Eigen::Matrix4d cov = s2 * lu.inverse();
+  // Stationary point with negative curvature nearest to the window's centre (u in [-1, 1]).
+  auto crest = [](const Eigen::Vector4d& k, double& u_out) {
+    const double a = 3 * k[3], b = 2 * k[2], cc = k[1];
+    double roots[2];
+    int n = 0;
+    if (std::abs(a) < 1e-12) {
+      if (std::abs(b) > 1e-12) roots[n++] = -cc / b;
+    } else {
+      const double disc = b * b - 4 * a * cc;
+      if (disc >= 0) {
+        roots[n++] = (-b + std::sqrt(disc)) / (2 * a);
+        roots[n++] = (-b - std::sqrt(disc)) / (2 * a);
+      }
+    }
+    bool found = false;
+    for (int i = 0; i < n; ++i) {
+      const double u = roots[i];
+      if (std::abs(u) > 1 || 2 * k[2] + 6 * k[3] * u >= 0) continue;
+      if (!found || std::abs(u) < std::abs(u_out)) u_out = u;
+      found = true;
+    }
+    return found;
+  };
+  auto value = [](const Eigen::Vector4d& k, double u) { return k[0] + u * (k[1] + u * (k[2] + u * k[3])); };
+  double u = 0;
+  if (!crest(c, u)) return false;
+  peak.x = x0 + u * half_window;
+  peak.depth = value(c, u);
+  // Uncertainty: numerical gradient of (x, depth) with respect to the coefficients.
+  Eigen::Vector4d gx, gd;
+  for (int k = 0; k < 4; ++k) {
+    const double h = 1e-6 * std::max(1e-3, std::abs(c[k]));
+    Eigen::Vector4d cp = c;
+    cp[k] += h;
+    double up = u;
+    if (!crest(cp, up)) up = u;
+    gx[k] = (up - u) * half_window / h;
+    gd[k] = (value(cp, up) - peak.depth) / h;
+  }
+  peak.sd_x = std::sqrt(std::max(0.0, gx.dot(cov * gx)));
+  peak.sd_depth = std::sqrt(std::max(0.0, gd.dot(cov * gd)));
+  return true;
+}
+
 struct Frame {
   Vec3 L, R, c_hat, y_hat, m;  // luff, leech, chord direction, in-plane normal to chord, plane normal
   double chord;
@@ -324,7 +390,7 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
     const auto xy = toChordCoords(cut, f);
     s.curve_samples = xy.size();
 
-    // Maximum depth: refined by a quadratic through the points around the deepest one.
+    // Maximum depth: refined by a cubic through the points around the deepest one.
     const size_t imax = maxDepthIndex(xy, f.chord);
     const double side = xy[imax].y() >= 0 ? 1.0 : -1.0;
     double depth = std::abs(xy[imax].y()), depth_x = xy[imax].x();
@@ -333,17 +399,15 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
       std::vector<Eigen::Vector2d> win;
       for (const auto& v : xy)
         if (std::abs(v.x() - depth_x) <= p.peak_window * f.chord) win.emplace_back(v.x(), side * v.y());
-      const QuadFit q = fitQuadratic(win, depth_x, 0.0);
-      if (q.ok && q.c[2] < 0) {
-        const double u = -q.c[1] / (2 * q.c[2]);
-        if (std::abs(u) <= p.peak_window * f.chord) {
-          depth = q.c[0] - q.c[1] * q.c[1] / (4 * q.c[2]);
-          depth_x += u;
-          const Eigen::Vector3d g_depth(1, -q.c[1] / (2 * q.c[2]), q.c[1] * q.c[1] / (4 * q.c[2] * q.c[2]));
-          const Eigen::Vector3d g_x(0, -1 / (2 * q.c[2]), q.c[1] / (2 * q.c[2] * q.c[2]));
-          sd_depth = std::sqrt(std::max(0.0, g_depth.dot(q.cov * g_depth)));
-          sd_x = std::sqrt(std::max(0.0, g_x.dot(q.cov * g_x)));
-        }
+      Peak peak;
+      if (fitPeak(win, depth_x, p.peak_window * f.chord, peak)) {
+        depth = peak.depth;
+        depth_x = peak.x;
+        sd_depth = peak.sd_depth;
+        sd_x = peak.sd_x;
+      } else {
+        result.warnings.push_back("section " + std::to_string(t) +
+                                  ": no crest in the peak fit; the deepest cut point is used");
       }
     }
     s.max_camber_point = f.L + depth_x * f.c_hat + side * depth * f.y_hat;

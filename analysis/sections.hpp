@@ -17,7 +17,7 @@ struct SectionParams {
   // "perpendicular": the start plane only; "horizontal": z = const through the luff point.
   std::string plane = "normal";
   double end_window = 0.10;           // fraction of chord for the entry/exit quadratic fits
-  double peak_window = 0.05;          // ± fraction of chord for the quadratic fit at maximum camber
+  double peak_window = 0.15;          // ± fraction of chord for the cubic fit at maximum camber
   double normal_tolerance_deg = 0.1;  // out-of-plane angle of the surface normal accepted as "contains"
   double max_tilt_deg = 45.0;         // limit of the rotation about the chord
   int max_iterations = 20;
