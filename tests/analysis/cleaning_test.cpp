@@ -12,27 +12,10 @@
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
-
-constexpr double kSigma = 0.004;  // sensor random error σ, SPEC §3
-
-// Runs `f`, which must throw InvalidInput whose message contains every part.
-template <class F>
-void expectInvalidInput(F f, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const InvalidInput& e) {
-          const std::string what = e.what();
-          for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
-          throw;
-        }
-      },
-      InvalidInput);
-}
 
 // A 2 m × 2 m plane z = 0 at 2500 points/m² with σ = 4 mm noise, and outliers
 // 0.5 m off it (alternately above and below) at random places over it.

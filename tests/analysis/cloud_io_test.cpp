@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "analysis/errors.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
@@ -24,23 +25,6 @@ namespace fs = std::filesystem;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// Runs `f`, which must throw FileError whose message starts with `prefix` and contains every part.
-void expectFileError(const std::function<void()>& f, const std::string& prefix, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const FileError& e) {
-          const std::string what = e.what();
-          EXPECT_EQ(what.rfind(prefix, 0), 0u) << "'" << what << "' does not start with '" << prefix << "'";
-          for (const auto& part : parts)
-            EXPECT_NE(what.find(part), std::string::npos) << "'" << what << "' lacks '" << part << "'";
-          throw;
-        }
-      },
-      FileError);
-}
 
 // readCloud(path) must fail with "<path>: ..." containing every part.
 #define EXPECT_READ_ERROR(path, ...)                                                           \

@@ -15,28 +15,12 @@
 #include <vector>
 
 #include "analysis/errors.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Runs `f`, which must throw FileError whose message starts with `prefix` and contains every part.
-void expectFileError(const std::function<void()>& f, const std::string& prefix, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const FileError& e) {
-          const std::string what = e.what();
-          EXPECT_EQ(what.rfind(prefix, 0), 0u) << "'" << what << "' does not start with '" << prefix << "'";
-          for (const auto& part : parts)
-            EXPECT_NE(what.find(part), std::string::npos) << "'" << what << "' lacks '" << part << "'";
-          throw;
-        }
-      },
-      FileError);
-}
 
 // readMesh(path) must fail with "<path>: ..." containing every part.
 #define EXPECT_READ_ERROR(path, ...)                                                          \

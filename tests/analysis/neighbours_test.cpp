@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/errors.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
@@ -23,22 +24,6 @@ std::vector<Vec3> grid(int n, double h) {
 }
 
 uint32_t at(int n, int i, int j) { return static_cast<uint32_t>(i * n + j); }
-
-// Runs `f`, which must throw InvalidInput whose message contains every part.
-template <class F>
-void expectInvalidInput(F f, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const InvalidInput& e) {
-          const std::string what = e.what();
-          for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
-          throw;
-        }
-      },
-      InvalidInput);
-}
 
 TEST(KdTree, NearestOnAGridFindsTheFourEdgeNeighboursAtSpacingH) {
   const int n = 10;

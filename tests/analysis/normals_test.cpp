@@ -10,28 +10,10 @@
 
 #include "analysis/errors.hpp"
 #include "analysis/sail_generator.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
-
-constexpr double kSigma = 0.004;  // sensor random error σ, SPEC §3
-constexpr double kDeg = M_PI / 180.0;
-
-// Runs `f`, which must throw InvalidInput whose message contains every part.
-template <class F>
-void expectInvalidInput(F f, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const InvalidInput& e) {
-          const std::string what = e.what();
-          for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
-          throw;
-        }
-      },
-      InvalidInput);
-}
 
 // A side × side square of the plane through `origin` with unit normal `normal`,
 // n points uniform over it, Gaussian noise σ along the normal.
@@ -71,16 +53,10 @@ double mean(const std::vector<double>& v) {
   return s / static_cast<double>(v.size());
 }
 
-// Points nearly uniform on a sphere (Fibonacci lattice): no clumps, so every
-// k-neighbourhood is close to a continuous spherical cap.
+// n points of the Fibonacci lattice on a sphere.
 Cloud fibonacciSphere(size_t n, double radius, const Vec3& centre) {
   Cloud cloud;
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  for (size_t i = 0; i < n; ++i) {
-    const double z = 1.0 - 2.0 * (static_cast<double>(i) + 0.5) / static_cast<double>(n);
-    const double rho = std::sqrt(1.0 - z * z), phi = golden * static_cast<double>(i);
-    cloud.points.push_back(centre + radius * Vec3(rho * std::cos(phi), rho * std::sin(phi), z));
-  }
+  for (size_t i = 0; i < n; ++i) cloud.points.push_back(centre + radius * fibonacciDirection(i, n));
   return cloud;
 }
 

@@ -8,28 +8,13 @@
 #include <vector>
 
 #include "analysis/errors.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-// Runs `f`, which must throw E whose message contains every part.
-template <class E, class F>
-void expectThrowWith(F f, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const E& e) {
-          const std::string what = e.what();
-          for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
-          throw;
-        }
-      },
-      E);
-}
 
 // A fresh directory under the system temp dir, removed afterwards.
 class ParamsFile : public ::testing::Test {

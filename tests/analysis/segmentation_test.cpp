@@ -12,27 +12,10 @@
 #include "analysis/errors.hpp"
 #include "analysis/normals.hpp"
 #include "analysis/sail_generator.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
-
-constexpr double kSigma = 0.004;  // sensor random error σ, SPEC §3
-
-// Runs `f`, which must throw E whose message contains every part.
-template <class E, class F>
-void expectThrowWith(F f, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const E& e) {
-          const std::string what = e.what();
-          for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
-          throw;
-        }
-      },
-      E);
-}
 
 // Appends a jittered cubic grid: side/spacing points per axis, each moved by at most `jitter` per axis.
 std::vector<uint32_t> addBlob(Cloud& cloud, const Vec3& corner, int per_axis, double spacing, double jitter,

@@ -9,27 +9,10 @@
 #include <vector>
 
 #include "analysis/errors.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
-
-constexpr double kSigma = 0.004;  // sensor random error σ, SPEC §3
-
-// Runs `f`, which must throw InvalidInput whose message contains every part.
-template <class F>
-void expectInvalidInput(F f, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const InvalidInput& e) {
-          const std::string what = e.what();
-          for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
-          throw;
-        }
-      },
-      InvalidInput);
-}
 
 // A 2 m × 2 m patch of the plane z = 0 at 2500 points/m², Gaussian noise σ in z.
 Cloud noisyPlane(size_t n, double sigma, uint32_t seed) {
@@ -47,13 +30,8 @@ Cloud noisySphere(double R, double density, double sigma, uint32_t seed) {
   const size_t n = static_cast<size_t>(4 * M_PI * R * R * density);
   std::mt19937 rng(seed);
   std::normal_distribution<double> N(0.0, 1.0);
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
   Cloud cloud;
-  for (size_t i = 0; i < n; ++i) {
-    const double z = 1.0 - 2.0 * (static_cast<double>(i) + 0.5) / static_cast<double>(n);
-    const double rho = std::sqrt(1.0 - z * z), phi = golden * static_cast<double>(i);
-    cloud.points.push_back((R + sigma * N(rng)) * Vec3(rho * std::cos(phi), rho * std::sin(phi), z));
-  }
+  for (size_t i = 0; i < n; ++i) cloud.points.push_back((R + sigma * N(rng)) * fibonacciDirection(i, n));
   return cloud;
 }
 

@@ -10,27 +10,10 @@
 #include <vector>
 
 #include "analysis/errors.hpp"
+#include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
-
-// Runs `f`, which must throw E whose message contains every part.
-template <class E, class F>
-void expectThrowWith(F f, const std::vector<std::string>& parts) {
-  EXPECT_THROW(
-      {
-        try {
-          f();
-        } catch (const E& e) {
-          const std::string what = e.what();
-          for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
-          throw;
-        }
-      },
-      E);
-}
 
 // A tilted frame, so nothing lines up with the axes.
 const Eigen::Matrix3d& tilt() {

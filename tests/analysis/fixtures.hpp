@@ -1,0 +1,69 @@
+#pragma once
+// Shared by tests/analysis/*_test.cpp: sensor constants, exception checks and
+// point generators. Header-only; every generator is deterministic.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "analysis/cloud.hpp"
+#include "analysis/errors.hpp"
+
+namespace sailshape {
+
+inline constexpr double kSigma = 0.004;  // sensor random error σ, SPEC §3
+inline constexpr double kDeg = M_PI / 180.0;
+
+// Runs `f`, which must throw E whose message contains every part.
+template <class E, class F>
+void expectThrowWith(F f, const std::vector<std::string>& parts) {
+  EXPECT_THROW(
+      {
+        try {
+          f();
+        } catch (const E& e) {
+          const std::string what = e.what();
+          for (const auto& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
+          throw;
+        }
+      },
+      E);
+}
+
+// Runs `f`, which must throw InvalidInput whose message contains every part.
+template <class F>
+void expectInvalidInput(F f, const std::vector<std::string>& parts) {
+  expectThrowWith<InvalidInput>(f, parts);
+}
+
+// Runs `f`, which must throw FileError whose message starts with `prefix` and contains every part.
+inline void expectFileError(const std::function<void()>& f, const std::string& prefix,
+                            const std::vector<std::string>& parts) {
+  EXPECT_THROW(
+      {
+        try {
+          f();
+        } catch (const FileError& e) {
+          const std::string what = e.what();
+          EXPECT_EQ(what.rfind(prefix, 0), 0u) << "'" << what << "' does not start with '" << prefix << "'";
+          for (const auto& part : parts)
+            EXPECT_NE(what.find(part), std::string::npos) << "'" << what << "' lacks '" << part << "'";
+          throw;
+        }
+      },
+      FileError);
+}
+
+// Point i of n nearly uniform on the unit sphere (Fibonacci lattice): no clumps,
+// no edges, so every k-neighbourhood is close to a continuous spherical cap.
+inline Vec3 fibonacciDirection(size_t i, size_t n) {
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  const double z = 1.0 - 2.0 * (static_cast<double>(i) + 0.5) / static_cast<double>(n);
+  const double rho = std::sqrt(1.0 - z * z), phi = golden * static_cast<double>(i);
+  return Vec3(rho * std::cos(phi), rho * std::sin(phi), z);
+}
+
+}  // namespace sailshape
