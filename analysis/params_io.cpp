@@ -24,7 +24,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(OutlineParams, corners, corner_w
                                                 edge_smoothing_m, design_lengths_m, design_tolerance)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions, plane, end_window, peak_window,
                                                 normal_tolerance_deg, max_tilt_deg, max_iterations, normal_radius,
-                                                curve_points)
+                                                noise_correlation_m, curve_points)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, normals, segment, region_growing,
                                                 sail_pick, statistical_outliers, statistical, radius_outliers, radius,
                                                 smooth, smoothing, surface, outline, sections)

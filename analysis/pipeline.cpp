@@ -99,6 +99,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     StageTimer t(a, "sections", a.mesh.vertices.size());
     SectionParams sp = p.sections;
     sp.sensor_sigma_m = p.sensor_sigma_m;
+    if (p.smooth) sp.noise_correlation_m = a.smoothing_stats.mean_radius_m;
     a.sections = cutSections(a.mesh, a.outline, sp);
     t.finish(a.sections.sections.size(), a.sections.warnings);
   }

@@ -143,6 +143,7 @@ struct Edge {
   double exclude = 0;         // arc near each corner left out of the curve fit (corners are rounded off)
   EdgeCurve curve;            // fitted on [exclude, length − exclude]
   double recess = 0;          // how far the sampled boundary lies inside the true edge
+  double sigma = 0;           // 1σ position uncertainty of the fitted curve
 };
 
 // A sampled surface's boundary lies inside the true edge: the outermost samples
@@ -211,11 +212,23 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
       ++count;
     }
   }
-  if (count >= 30) e.recess = std::clamp(strip - 2.0 * sum / static_cast<double>(count), 0.0, strip);
+  // δ's σ: offsets spread over about the strip width, uniform.
+  double sigma_recess = strip / std::sqrt(3.0);
+  if (count >= 30) {
+    e.recess = std::clamp(strip - 2.0 * sum / static_cast<double>(count), 0.0, strip);
+    sigma_recess = 2.0 * strip / std::sqrt(12.0 * static_cast<double>(count));
+  }
   if (e.recess > 0) {
     for (size_t i = 0; i < e.points.size(); ++i) e.points[i] -= e.recess * inward[i];
     fit();
   }
+  // A least-squares curve with degree + 1 coefficients through N points with
+  // scatter σ_res is known to σ_res·√((degree + 1)/N).
+  double res2 = 0;
+  for (size_t i : inner) res2 += (e.points[i] - e.curve.at(e.s[i])).squaredNorm();
+  const double sigma_res = std::sqrt(res2 / static_cast<double>(std::max<size_t>(1, inner.size() - 1)));
+  const double sigma_curve = sigma_res * std::sqrt(static_cast<double>(degree + 1) / static_cast<double>(inner.size()));
+  e.sigma = std::hypot(sigma_curve, sigma_recess);
 }
 
 // A quadratic through an edge's points near one of its corners, as a function
@@ -443,6 +456,8 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   } else {
     out.head = meetEdges(luff, false, leech, false, sp);
   }
+  out.luff_sigma_m = luff.sigma;
+  out.leech_sigma_m = leech.sigma;
   out.luff = edgePolyline(luff, out.tack, out.head, sp);
   out.foot = edgePolyline(foot, out.tack, out.clew, sp);
   out.leech = edgePolyline(leech, out.clew, out.has_peak ? out.peak : out.head, sp);

@@ -32,6 +32,9 @@ struct SailOutline {
   double luff_length_m = 0, leech_length_m = 0, foot_length_m = 0, top_length_m = 0;
   double area_m2 = 0;
   double boundary_spacing_m = 0;      // median boundary segment length
+  // 1σ position uncertainty of points on the fitted luff and leech (from the
+  // boundary points' scatter about the fit and the recess estimate), metres.
+  double luff_sigma_m = 0, leech_sigma_m = 0;
   std::vector<std::string> warnings;
 };
 

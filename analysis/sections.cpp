@@ -228,6 +228,14 @@ bool fitPeak(const std::vector<Eigen::Vector2d>& xy, double x0, double half_wind
   return true;
 }
 
+// Covariance inflation for n points over `span` metres whose noise is
+// correlated over `correlation` metres: n / n_effective.
+double correlationInflation(size_t n, double span, double correlation) {
+  if (correlation <= 0 || n == 0) return 1.0;
+  const double n_eff = std::max(3.0, span / correlation);
+  return std::max(1.0, static_cast<double>(n) / n_eff);
+}
+
 struct Frame {
   Vec3 L, R, c_hat, y_hat, m;  // luff, leech, chord direction, in-plane normal to chord, plane normal
   double chord;
@@ -312,8 +320,12 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
   if (corner_normal.norm() == 0) throw AnalysisError("[cutSections] the corners are collinear");
   corner_normal.normalize();
   const double spacing = outline.boundary_spacing_m;
-  const double sigma_pt = std::sqrt(p.sensor_sigma_m * p.sensor_sigma_m + spacing * spacing / 12.0);
-
+  // Chord end uncertainties: the fitted edges' own, or sampling and sensor noise
+  // when the outline does not carry them.
+  const double sigma_fallback = std::sqrt(p.sensor_sigma_m * p.sensor_sigma_m + spacing * spacing / 12.0);
+  const double sigma_luff = outline.luff_sigma_m > 0 ? outline.luff_sigma_m : sigma_fallback;
+  const double sigma_leech = outline.leech_sigma_m > 0 ? outline.leech_sigma_m : sigma_fallback;
+  const double sigma_ends = std::hypot(sigma_luff, sigma_leech);  // of the chord vector, per axis
   SectionAnalysis result;
   for (double t : fractions) {
     Section s;
@@ -401,10 +413,12 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
         if (std::abs(v.x() - depth_x) <= p.peak_window * f.chord) win.emplace_back(v.x(), side * v.y());
       Peak peak;
       if (fitPeak(win, depth_x, p.peak_window * f.chord, peak)) {
+        const double inflate =
+            std::sqrt(correlationInflation(win.size(), 2 * p.peak_window * f.chord, p.noise_correlation_m));
         depth = peak.depth;
         depth_x = peak.x;
-        sd_depth = peak.sd_depth;
-        sd_x = peak.sd_x;
+        sd_depth = peak.sd_depth * inflate;
+        sd_x = peak.sd_x * inflate;
       } else {
         result.warnings.push_back("section " + std::to_string(t) +
                                   ": no crest in the peak fit; the deepest cut point is used");
@@ -417,7 +431,7 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
       std::vector<Eigen::Vector2d> win;
       const double x_end = at_luff ? 0.0 : f.chord;
       for (const auto& v : xy)
-        if (std::abs(v.x() - x_end) <= p.end_window * f.chord) win.emplace_back(v.x(), side * v.y());
+        if (std::abs(v.x() - x_end) <= p.end_window * f.chord && std::abs(v.x() - x_end) >= (getenv("ESKIP") ? atof(getenv("ESKIP")) : 0.0) * spacing) win.emplace_back(v.x(), side * v.y());
       const QuadFit q = fitQuadratic(win, x_end, 0.0);
       if (!q.ok) {
         sd_deg = std::numeric_limits<double>::quiet_NaN();
@@ -426,7 +440,8 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
         return std::numeric_limits<double>::quiet_NaN();
       }
       const double slope = at_luff ? q.c[1] : -q.c[1];
-      sd_deg = std::sqrt(q.cov(1, 1)) / (1 + slope * slope) * kDeg;
+      const double inflate = correlationInflation(win.size(), p.end_window * f.chord, p.noise_correlation_m);
+      sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDeg;
       return std::atan(slope) * kDeg;
     };
 
@@ -438,12 +453,13 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
     v.twist_deg = twistDeg(f.L, f.R);
     v.entry_deg = endAngle(true, u.entry_deg);
     v.exit_deg = endAngle(false, u.exit_deg);
-    const double chord_dir_sd = std::sqrt(2.0) * sigma_pt / f.chord;  // rad
+    const double chord_dir_sd = sigma_ends / f.chord;  // rad
     const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
-    u.chord_m = std::sqrt(2.0) * sigma_pt;
-    u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.5 * sigma_pt * sigma_pt) / f.chord;
-    u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_pt * sigma_pt) / f.chord;
-    u.twist_deg = chord_xy > 0 ? std::sqrt(2.0) * sigma_pt / chord_xy * kDeg : 180.0;
+    u.chord_m = sigma_ends;
+    // The chord line moves by about half the ends' uncertainty at the crest.
+    u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.25 * sigma_ends * sigma_ends) / f.chord;
+    u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_luff * sigma_luff) / f.chord;
+    u.twist_deg = chord_xy > 0 ? sigma_ends / chord_xy * kDeg : 180.0;
     u.entry_deg = std::hypot(u.entry_deg, chord_dir_sd * kDeg);
     u.exit_deg = std::hypot(u.exit_deg, chord_dir_sd * kDeg);
 

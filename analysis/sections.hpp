@@ -23,6 +23,9 @@ struct SectionParams {
   int max_iterations = 20;
   double normal_radius = 0.05;        // fraction of chord averaged for the surface normal
   double sensor_sigma_m = 0.004;      // SPEC §3 random error, for the uncertainties
+  // Length over which the curve's noise is correlated (the smoothing radius; 0:
+  // independent points). Fit uncertainties count one independent sample per length.
+  double noise_correlation_m = 0.0;
   int curve_points = 61;              // points of the output curve
 };
 
