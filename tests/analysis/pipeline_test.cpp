@@ -75,22 +75,18 @@ TEST(Pipeline, CleanJibRecoversKnownSections) {
   EXPECT_FALSE(a.outline.has_peak);
 }
 
-TEST(Pipeline, CleanGennakerRecoversDraftEndAnglesAndLuffCurve) {
-  // Camber (0.13 % off at the lowest section), twist (0.17°) and the tack (7 cm)
-  // of the curved-luff gennaker are not within the clean targets yet;
-  // draft and the end angles are.
+TEST(Pipeline, CleanGennakerRecoversKnownSectionsAndLuffCurve) {
+  // 100,000 points on the 44 m² gennaker: the mainsail's point density.
   const SailDesign design = exampleDesign(SailType::Gennaker);
   ScanSimulation sim;
-  sim.points = 40000;
+  sim.points = 100000;
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   const SailSurface truth(design);
-  ASSERT_EQ(a.sections.sections.size(), 3u);
-  for (const Section& s : a.sections.sections) {
-    const KnownSection k = truth.section(s.fraction);
-    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, kClean.draft_pct);
-    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, kClean.end_deg);
-    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, kClean.end_deg);
-  }
+  expectSectionsMatch(a, truth, kClean);
+  EXPECT_LT((a.outline.tack - truth.tack()).norm(), kClean.corner_m);
+  EXPECT_LT((a.outline.clew - truth.clew()).norm(), kClean.corner_m);
+  // The head, where the curved luff meets the leech at a narrow angle, is 4 cm
+  // off on this seed (1–4 cm over seeds): not yet within the 3 cm target.
   // The luff curve measured on the design's own luff, corners and clew.
   SailOutline design_outline;
   design_outline.tack = truth.tack();
@@ -100,10 +96,9 @@ TEST(Pipeline, CleanGennakerRecoversDraftEndAnglesAndLuffCurve) {
   const LuffCurve expected = measureLuffCurve(design_outline);
   ASSERT_GT(std::abs(expected.lusw_sag_m), 0.3);  // the design's luff really sags
   // Sags are offsets of the luff from the tack–head line, so they carry the
-  // corners' error: 3 cm in the sail's plane; out of it the 7 cm tack error
-  // above tilts the line, so 5 cm until the gennaker's tack is fixed.
+  // corners' error, up to the 3 cm corner tolerance.
   EXPECT_NEAR(a.luff.lufa_sag_m, expected.lufa_sag_m, 0.03);
-  EXPECT_NEAR(a.luff.lusw_sag_m, expected.lusw_sag_m, 0.05);
+  EXPECT_NEAR(a.luff.lusw_sag_m, expected.lusw_sag_m, 0.03);
 }
 
 TEST(Pipeline, NoisyMainsailRecoversKnownSectionsWithinTheNoiseTargets) {
