@@ -50,8 +50,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     const Segmentation seg = growRegions(cloud, normals.normals, table, p.region_growing, progress);
     const SailPick pick = pickSailCluster(cloud, seg, p.sail_pick);
     a.clusters = pick.candidates;
-    std::vector<uint32_t> idx = seg.clusters[pick.cluster];
-    std::sort(idx.begin(), idx.end());
+    const std::vector<uint32_t> idx = addClusterFringe(seg, pick.cluster, table);
     cloud = selectPoints(cloud, idx);
     std::vector<std::string> w = normals.warnings;
     w.insert(w.end(), seg.warnings.begin(), seg.warnings.end());

@@ -371,6 +371,14 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
                     turnAt(picked[3], 2.0 * w) >= p.min_fourth_corner_deg
                 ? 4
                 : 3;
+    if (count == 4) {
+      // A square head's two corners both stand near the top of the sail, not
+      // halfway up an edge (a kink from a few mast points at the luff).
+      std::vector<double> z;
+      for (size_t c : picked) z.push_back(pts[c].z());
+      std::sort(z.begin(), z.end());
+      if (z[2] - z[1] < 0.6 * (z[3] - z[0])) count = 3;
+    }
   }
   if (picked.size() < count)
     throw AnalysisError("[extractOutline] asked for " + std::to_string(count) + " corners, found " +

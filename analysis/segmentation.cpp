@@ -146,6 +146,38 @@ Segmentation growRegions(const Cloud& cloud, const Normals& normals, const Neigh
   return result;
 }
 
+std::vector<uint32_t> addClusterFringe(const Segmentation& seg, size_t cluster, const NeighbourTable& table,
+                                       double min_fraction, int passes) {
+  if (cluster >= seg.clusters.size())
+    throw InvalidInput("[addClusterFringe] cluster " + std::to_string(cluster) + " out of range (" +
+                       std::to_string(seg.clusters.size()) + " clusters)");
+  if (table.k < 2) throw InvalidInput("[addClusterFringe] the neighbour table needs k >= 2");
+  const size_t n = table.size();
+  // 1: in the cluster, 2: in another cluster, 0: unassigned.
+  std::vector<char> state(n, 0);
+  for (size_t c = 0; c < seg.clusters.size(); ++c)
+    for (uint32_t i : seg.clusters[c]) {
+      if (i >= n) throw InvalidInput("[addClusterFringe] cluster index beyond the neighbour table");
+      state[i] = c == cluster ? 1 : 2;
+    }
+  std::vector<uint32_t> members = seg.clusters[cluster];
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<uint32_t> added;
+    for (uint32_t i : seg.unassigned) {
+      if (i >= n || state[i] != 0) continue;
+      const uint32_t* row = table.row(i);
+      size_t in = 0;
+      for (size_t j = 1; j < table.k; ++j) in += state[row[j]] == 1;
+      if (static_cast<double>(in) > min_fraction * static_cast<double>(table.k - 1)) added.push_back(i);
+    }
+    if (added.empty()) break;
+    for (uint32_t i : added) state[i] = 1;
+    members.insert(members.end(), added.begin(), added.end());
+  }
+  std::sort(members.begin(), members.end());
+  return members;
+}
+
 SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const SailPickParams& p) {
   if (seg.clusters.empty()) throw AnalysisError("[pickSailCluster] segmentation found no cluster to pick a sail from");
   SailPick pick;

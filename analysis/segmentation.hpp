@@ -32,7 +32,7 @@ Segmentation clusterEuclidean(const Cloud& cloud, const EuclideanClusterParams& 
 struct RegionGrowingParams {
   int k_neighbours = 30;
   double max_normal_angle_deg = 7.0;
-  double max_curvature = 0.05;
+  double max_curvature = 0.03;
   size_t min_points = 500;
   size_t max_points = 50'000'000;
 };
@@ -74,6 +74,13 @@ struct SailPick {
   std::vector<ClusterInfo> candidates;  // one per cluster, same order
   std::vector<std::string> warnings;
 };
+
+// Adds to `cluster` the points outside every cluster (left unassigned, as
+// edge points with one-sided neighbourhoods often are) when more than
+// min_fraction of their neighbours (table rows, self excluded) are in it; repeated
+// `passes` times. A mast beside the luff stays out: its points' neighbours are mast.
+std::vector<uint32_t> addClusterFringe(const Segmentation& segmentation, size_t cluster, const NeighbourTable& table,
+                                       double min_fraction = 0.5, int passes = 2);
 
 // Throws AnalysisError when there is no cluster or nothing sail-like.
 SailPick pickSailCluster(const Cloud& cloud, const Segmentation& segmentation, const SailPickParams& params = {});

@@ -405,5 +405,31 @@ TEST(PickSailCluster, RejectsBadMethodsSeedsAndIndices) {
   }
 }
 
+TEST(AddClusterFringe, AdoptsUnassignedEdgePointsButNotANeighbouringCluster) {
+  // A 40 x 40 grid (1 cm): columns 0-29 are the cluster, column 30 is unassigned
+  // (an edge strip), columns 31-39 are another cluster. Column 30's points have
+  // 8 neighbours in k = 9 rows: about half on each side, so with min_fraction
+  // 0.3 they join; the other cluster's points never do.
+  Cloud c;
+  Segmentation seg;
+  seg.clusters.resize(2);
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const uint32_t id = static_cast<uint32_t>(c.points.size());
+      c.points.emplace_back(0.01 * i, 0.01 * j, 0.0);
+      if (i < 30) seg.clusters[0].push_back(id);
+      else if (i == 30) seg.unassigned.push_back(id);
+      else seg.clusters[1].push_back(id);
+    }
+  const NeighbourTable table = nearestNeighbours(c.points, 9);
+  const std::vector<uint32_t> members = addClusterFringe(seg, 0, table, 0.3, 1);
+  EXPECT_EQ(members.size(), 31u * 40u);
+  EXPECT_TRUE(std::is_sorted(members.begin(), members.end()));
+  for (uint32_t m : members) EXPECT_LE(c.points[m].x(), 0.30 + 1e-9);
+  // A strict fraction keeps the strip out: only 3-4 of its 8 neighbours are in the cluster.
+  EXPECT_EQ(addClusterFringe(seg, 0, table, 0.6, 1).size(), 30u * 40u);
+  EXPECT_THROW(addClusterFringe(seg, 2, table), InvalidInput);
+}
+
 }  // namespace
 }  // namespace sailshape
