@@ -1,0 +1,344 @@
+#include "analysis/design_compare.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <random>
+#include <nanoflann.hpp>
+#include <utility>
+
+#include "analysis/errors.hpp"
+#include "analysis/surface.hpp"
+
+namespace sailshape {
+namespace {
+
+struct CentroidAdaptor {
+  const std::vector<Vec3>& pts;
+  size_t kdtree_get_point_count() const { return pts.size(); }
+  double kdtree_get_pt(size_t i, size_t dim) const { return pts[i][static_cast<int>(dim)]; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const { return false; }
+};
+
+using CentroidTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CentroidAdaptor>,
+                                                         CentroidAdaptor, 3, uint32_t>;
+
+// Unit normal of the least-squares plane through `points`, and their mean.
+std::pair<Vec3, Vec3> fitPlane(const std::vector<Vec3>& points) {
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : points) cov += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  return {es.eigenvectors().col(0).normalized(), mean};
+}
+
+double percentile(const std::vector<double>& sorted, double q) {
+  const double x = q * static_cast<double>(sorted.size() - 1);
+  const size_t i = static_cast<size_t>(std::floor(x));
+  if (i + 1 >= sorted.size()) return sorted.back();
+  return sorted[i] + (x - static_cast<double>(i)) * (sorted[i + 1] - sorted[i]);
+}
+
+SectionParameters minus(const SectionParameters& a, const SectionParameters& b) {
+  SectionParameters d;
+  d.chord_m = a.chord_m - b.chord_m;
+  d.camber_pct = a.camber_pct - b.camber_pct;
+  d.draft_pct = a.draft_pct - b.draft_pct;
+  d.twist_deg = a.twist_deg - b.twist_deg;
+  d.twist_rel_deg = a.twist_rel_deg - b.twist_rel_deg;
+  d.entry_deg = a.entry_deg - b.entry_deg;
+  d.exit_deg = a.exit_deg - b.exit_deg;
+  return d;
+}
+
+}  // namespace
+
+struct DesignDistance::Index {
+  CentroidAdaptor adaptor;
+  CentroidTree tree;
+  explicit Index(const std::vector<Vec3>& centroids)
+      : adaptor{centroids}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
+    tree.buildIndex();
+  }
+};
+
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  if (!std::isfinite(denom)) return a;  // degenerate triangle: its corners and edges were tried above
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+DesignDistance::DesignDistance(const Mesh& design) {
+  if (design.triangles.empty()) throw InvalidInput("[DesignDistance] the design mesh has no triangles");
+  const size_t nv = design.vertices.size(), nt = design.triangles.size();
+  for (size_t t = 0; t < nt; ++t)
+    for (uint32_t v : design.triangles[t])
+      if (v >= nv)
+        throw InvalidInput("[DesignDistance] triangle " + std::to_string(t) + " has vertex index " +
+                           std::to_string(v) + " out of range (" + std::to_string(nv) + " vertices)");
+  a_.resize(nt);
+  b_.resize(nt);
+  c_.resize(nt);
+  normal_.resize(nt);
+  centroid_.resize(nt);
+  std::vector<double> area(nt);
+  std::map<std::pair<uint32_t, uint32_t>, int> edge_use;
+  double total_area = 0;
+  for (size_t t = 0; t < nt; ++t) {
+    const auto& tri = design.triangles[t];
+    a_[t] = design.vertices[tri[0]];
+    b_[t] = design.vertices[tri[1]];
+    c_[t] = design.vertices[tri[2]];
+    centroid_[t] = (a_[t] + b_[t] + c_[t]) / 3.0;
+    const Vec3 n = (b_[t] - a_[t]).cross(c_[t] - a_[t]);
+    area[t] = 0.5 * n.norm();
+    total_area += area[t];
+    normal_[t] = area[t] > 0 ? Vec3(n.normalized()) : Vec3::Zero();
+    for (const Vec3* v : {&a_[t], &b_[t], &c_[t]}) max_reach_m_ = std::max(max_reach_m_, (*v - centroid_[t]).norm());
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t u = tri[static_cast<size_t>(k)], w = tri[static_cast<size_t>((k + 1) % 3)];
+      ++edge_use[{std::min(u, w), std::max(u, w)}];
+    }
+  }
+  if (!(total_area > 0)) throw InvalidInput("[DesignDistance] the design mesh has zero area");
+
+  // Leeward: the boundary spans the sail's "flat"; the cambered area bulges to one side of it.
+  std::vector<char> on_boundary(nv, 0);
+  for (const auto& [edge, uses] : edge_use)
+    if (uses == 1) on_boundary[edge.first] = on_boundary[edge.second] = 1;
+  std::vector<Vec3> rim;
+  for (size_t v = 0; v < nv; ++v)
+    if (on_boundary[v]) rim.push_back(design.vertices[v]);
+  if (rim.size() < 3) {
+    warnings_.push_back("the design mesh has no boundary: leeward taken from the plane fitted to all its vertices");
+    rim = design.vertices;
+  }
+  auto [n, origin] = fitPlane(rim);
+  double offset = 0;
+  for (size_t t = 0; t < nt; ++t) offset += area[t] * (centroid_[t] - origin).dot(n);
+  offset /= total_area;
+  const double size = std::sqrt(total_area);
+  cambered_ = std::abs(offset) > 1e-6 * size;
+  if (cambered_) {
+    if (offset < 0) n = -n;
+  } else {
+    // No side to bulge to: a fixed convention, port first.
+    const double key = std::abs(n.y()) > 1e-9 ? n.y() : std::abs(n.z()) > 1e-9 ? n.z() : n.x();
+    if (key < 0) n = -n;
+    warnings_.push_back("the design is flat: distances are positive along its normal towards +Y (port), or +Z, +X");
+  }
+  leeward_ = n;
+  for (Vec3& tn : normal_)
+    if (tn.dot(leeward_) < 0) tn = -tn;
+  index_ = std::make_unique<Index>(centroid_);
+}
+
+DesignDistance::~DesignDistance() = default;
+
+DesignDistance::Closest DesignDistance::closest(const Vec3& p) const {
+  // The nearest centroid's triangle bounds the distance; any closer triangle has
+  // its centroid within that bound plus the largest centroid → corner reach.
+  uint32_t t0 = 0;
+  double d2_centroid = 0;
+  index_->tree.knnSearch(p.data(), 1, &t0, &d2_centroid);
+  Closest best;
+  best.triangle = t0;
+  best.point = closestPointOnTriangle(p, a_[t0], b_[t0], c_[t0]);
+  double best_d2 = (p - best.point).squaredNorm();
+  const double radius = std::sqrt(best_d2) + max_reach_m_;
+  thread_local std::vector<std::pair<uint32_t, double>> matches;
+  matches.clear();
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  index_->tree.radiusSearch(p.data(), radius * radius, matches, params);
+  for (const auto& [t, d2c] : matches) {
+    if (t == t0) continue;
+    const double lower = std::sqrt(d2c) - max_reach_m_;
+    if (lower > 0 && lower * lower >= best_d2) continue;
+    const Vec3 q = closestPointOnTriangle(p, a_[t], b_[t], c_[t]);
+    const double d2 = (p - q).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best.point = q;
+      best.triangle = t;
+    }
+  }
+  const double d = std::sqrt(best_d2);
+  best.distance_m = (p - best.point).dot(normal_[best.triangle]) < 0 ? -d : d;
+  return best;
+}
+
+DistanceStats distanceStats(const std::vector<double>& d) {
+  if (d.empty()) throw InvalidInput("[distanceStats] no distances");
+  DistanceStats s;
+  s.count = d.size();
+  double sum = 0, sum2 = 0;
+  for (double v : d) {
+    sum += v;
+    sum2 += v * v;
+    s.max_abs_m = std::max(s.max_abs_m, std::abs(v));
+  }
+  s.mean_m = sum / static_cast<double>(d.size());
+  s.rms_m = std::sqrt(sum2 / static_cast<double>(d.size()));
+  std::vector<double> sorted = d;
+  std::sort(sorted.begin(), sorted.end());
+  s.p5_m = percentile(sorted, 0.05);
+  s.p50_m = percentile(sorted, 0.50);
+  s.p95_m = percentile(sorted, 0.95);
+  return s;
+}
+
+std::vector<double> signedDistances(const DesignDistance& design, const std::vector<Vec3>& points,
+                                    const Progress& progress) {
+  std::vector<double> out(points.size());
+  const long n = static_cast<long>(points.size());
+  const long chunk = 16384;
+  for (long start = 0; start < n; start += chunk) {
+    const long end = std::min(n, start + chunk);
+#pragma omp parallel for schedule(dynamic, 256)
+    for (long i = start; i < end; ++i)
+      out[static_cast<size_t>(i)] = design.signedDistance(points[static_cast<size_t>(i)]);
+    progress("distances", static_cast<double>(end) / static_cast<double>(n));
+  }
+  return out;
+}
+
+BoundaryCount countBoundary(const Mesh& mesh) {
+  std::map<std::pair<uint32_t, uint32_t>, int> use;
+  for (const auto& t : mesh.triangles)
+    for (size_t k = 0; k < 3; ++k) {
+      const uint32_t u = t[k], w = t[(k + 1) % 3];
+      ++use[{std::min(u, w), std::max(u, w)}];
+    }
+  // Loops = connected components of the boundary edges (union–find on their vertices).
+  std::map<uint32_t, uint32_t> parent;
+  std::function<uint32_t(uint32_t)> root = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  BoundaryCount c;
+  for (const auto& [e, n] : use) {
+    if (n != 1) continue;
+    ++c.edges;
+    for (uint32_t v : {e.first, e.second}) parent.try_emplace(v, v);
+    parent[root(e.first)] = root(e.second);
+  }
+  for (const auto& [v, p] : parent)
+    if (v == p) ++c.loops;
+  return c;
+}
+
+Cloud sampleMesh(const Mesh& mesh, size_t points, uint64_t seed) {
+  if (mesh.triangles.empty()) throw InvalidInput("[sampleMesh] the mesh has no triangles");
+  if (points == 0) throw InvalidInput("[sampleMesh] points must be > 0");
+  std::vector<double> cdf;
+  double total = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (uint32_t v : mesh.triangles[t])
+      if (v >= mesh.vertices.size())
+        throw InvalidInput("[sampleMesh] triangle " + std::to_string(t) + " has vertex index " + std::to_string(v) +
+                           " out of range (" + std::to_string(mesh.vertices.size()) + " vertices)");
+    total += 0.5 * ((mesh.vertices[mesh.triangles[t][1]] - mesh.vertices[mesh.triangles[t][0]])
+                        .cross(mesh.vertices[mesh.triangles[t][2]] - mesh.vertices[mesh.triangles[t][0]]))
+                       .norm();
+    cdf.push_back(total);
+  }
+  if (!(total > 0)) throw InvalidInput("[sampleMesh] the mesh has zero area");
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  Cloud cloud;
+  cloud.points.reserve(points);
+  for (size_t i = 0; i < points; ++i) {
+    const size_t t = std::min(static_cast<size_t>(std::lower_bound(cdf.begin(), cdf.end(), U(rng) * total) - cdf.begin()),
+                              cdf.size() - 1);
+    const auto& tri = mesh.triangles[t];
+    const double r1 = std::sqrt(U(rng)), r2 = U(rng);  // uniform over the triangle
+    cloud.points.push_back((1 - r1) * mesh.vertices[tri[0]] + r1 * (1 - r2) * mesh.vertices[tri[1]] +
+                           r1 * r2 * mesh.vertices[tri[2]]);
+  }
+  return cloud;
+}
+
+MeshSections analyzeMeshSections(const Mesh& mesh, const OutlineParams& outline, const SectionParams& sections,
+                                 const MeshSampling& sampling) {
+  if (sampling.mode != "auto" && sampling.mode != "mesh" && sampling.mode != "resample")
+    throw InvalidInput("[analyzeMeshSections] sampling mode must be auto, mesh or resample (got '" + sampling.mode + "')");
+  MeshSections r;
+  const BoundaryCount b = countBoundary(mesh);
+  r.resampled = sampling.mode == "resample" ||
+                (sampling.mode == "auto" && (b.loops != 1 || b.edges < sampling.min_boundary_edges));
+  if (!r.resampled) {
+    r.outline = extractOutline(mesh, outline);
+    r.sections = cutSections(mesh, r.outline, sections);
+    return r;
+  }
+  r.notes.push_back("mesh resampled for the analysis: " + std::to_string(b.edges) + " boundary edges in " +
+                    std::to_string(b.loops) + " loop(s); " + std::to_string(sampling.points) +
+                    " uniform samples meshed again");
+  SurfaceParams sp;
+  sp.projection = "plane";
+  const Surface surface = reconstructSurface(sampleMesh(mesh, sampling.points, sampling.seed), sp);
+  r.outline = extractOutline(surface.mesh, outline);
+  r.sections = cutSections(surface.mesh, r.outline, sections);
+  return r;
+}
+
+std::vector<SectionDelta> sectionDeltas(const SectionAnalysis& design, const SectionAnalysis& flying) {
+  auto fractions = [](const SectionAnalysis& a) {
+    std::string s;
+    for (const Section& x : a.sections) s += (s.empty() ? "" : ", ") + std::to_string(x.fraction);
+    return "[" + s + "]";
+  };
+  bool same = design.sections.size() == flying.sections.size();
+  for (size_t i = 0; same && i < design.sections.size(); ++i)
+    same = std::abs(design.sections[i].fraction - flying.sections[i].fraction) < 1e-9;
+  if (!same)
+    throw InvalidInput("[sectionDeltas] design sections at " + fractions(design) + " but flying sections at " +
+                       fractions(flying));
+  std::vector<SectionDelta> out;
+  for (size_t i = 0; i < design.sections.size(); ++i) {
+    SectionDelta d;
+    d.fraction = design.sections[i].fraction;
+    d.design = design.sections[i].value;
+    d.flying = flying.sections[i].value;
+    d.delta = minus(d.flying, d.design);
+    out.push_back(d);
+  }
+  return out;
+}
+
+DesignComparison compareWithDesign(const Mesh& design, const SectionAnalysis& design_sections,
+                                   const std::vector<Vec3>& flying_points, const SectionAnalysis& flying_sections,
+                                   const Progress& progress) {
+  if (flying_points.empty()) throw InvalidInput("[compareWithDesign] no flying points");
+  DesignComparison c;
+  c.sections = sectionDeltas(design_sections, flying_sections);
+  const DesignDistance distance(design);
+  c.leeward = distance.leeward();
+  c.warnings = distance.warnings();
+  c.distance_m = signedDistances(distance, flying_points, progress);
+  c.stats = distanceStats(c.distance_m);
+  return c;
+}
+
+}  // namespace sailshape
