@@ -2,11 +2,12 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <functional>
 #include <map>
 #include <random>
-#include <nanoflann.hpp>
 #include <utility>
 
 #include "analysis/errors.hpp"
@@ -14,17 +15,6 @@
 
 namespace sailshape {
 namespace {
-
-struct CentroidAdaptor {
-  const std::vector<Vec3>& pts;
-  size_t kdtree_get_point_count() const { return pts.size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return pts[i][static_cast<int>(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
-};
-
-using CentroidTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CentroidAdaptor>,
-                                                         CentroidAdaptor, 3, uint32_t>;
 
 // Unit normal of the least-squares plane through `points`, and their mean.
 std::pair<Vec3, Vec3> fitPlane(const std::vector<Vec3>& points) {
@@ -58,12 +48,52 @@ SectionParameters minus(const SectionParameters& a, const SectionParameters& b) 
 
 }  // namespace
 
+// Bounding volume hierarchy over the triangles: boxes split at the median
+// centroid along their longest side, leaves of up to 4 triangles. A query
+// visits the nearer child first and skips boxes farther than the best so far.
 struct DesignDistance::Index {
-  CentroidAdaptor adaptor;
-  CentroidTree tree;
-  explicit Index(const std::vector<Vec3>& centroids)
-      : adaptor{centroids}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
-    tree.buildIndex();
+  struct Node {
+    Eigen::AlignedBox3d box;
+    uint32_t first = 0, count = 0;  // leaf: triangles order[first, first + count)
+    uint32_t left = 0, right = 0;   // inner node: children
+  };
+  std::vector<Node> nodes;
+  std::vector<uint32_t> order;
+
+  Index(const std::vector<Vec3>& a, const std::vector<Vec3>& b, const std::vector<Vec3>& c,
+        const std::vector<Vec3>& centroid) {
+    order.resize(centroid.size());
+    for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    nodes.reserve(2 * order.size() / 4 + 2);
+    build(0, static_cast<uint32_t>(order.size()), a, b, c, centroid);
+  }
+
+  uint32_t build(uint32_t first, uint32_t count, const std::vector<Vec3>& a, const std::vector<Vec3>& b,
+                 const std::vector<Vec3>& c, const std::vector<Vec3>& centroid) {
+    const uint32_t id = static_cast<uint32_t>(nodes.size());
+    nodes.emplace_back();
+    Eigen::AlignedBox3d box, centres;
+    for (uint32_t i = first; i < first + count; ++i) {
+      const uint32_t t = order[i];
+      box.extend(a[t]).extend(b[t]).extend(c[t]);
+      centres.extend(centroid[t]);
+    }
+    nodes[id].box = box;
+    if (count <= 4) {
+      nodes[id].first = first;
+      nodes[id].count = count;
+      return id;
+    }
+    int axis = 0;
+    centres.sizes().maxCoeff(&axis);
+    const uint32_t half = count / 2;
+    std::nth_element(order.begin() + first, order.begin() + first + half, order.begin() + first + count,
+                     [&](uint32_t x, uint32_t y) { return centroid[x][axis] < centroid[y][axis]; });
+    const uint32_t left = build(first, half, a, b, c, centroid);
+    const uint32_t right = build(first + half, count - half, a, b, c, centroid);
+    nodes[id].left = left;
+    nodes[id].right = right;
+    return id;
   }
 };
 
@@ -114,7 +144,6 @@ DesignDistance::DesignDistance(const Mesh& design) {
     area[t] = 0.5 * n.norm();
     total_area += area[t];
     normal_[t] = area[t] > 0 ? Vec3(n.normalized()) : Vec3::Zero();
-    for (const Vec3* v : {&a_[t], &b_[t], &c_[t]}) max_reach_m_ = std::max(max_reach_m_, (*v - centroid_[t]).norm());
     for (int k = 0; k < 3; ++k) {
       const uint32_t u = tri[static_cast<size_t>(k)], w = tri[static_cast<size_t>((k + 1) % 3)];
       ++edge_use[{std::min(u, w), std::max(u, w)}];
@@ -150,37 +179,42 @@ DesignDistance::DesignDistance(const Mesh& design) {
   leeward_ = n;
   for (Vec3& tn : normal_)
     if (tn.dot(leeward_) < 0) tn = -tn;
-  index_ = std::make_unique<Index>(centroid_);
+  index_ = std::make_unique<Index>(a_, b_, c_, centroid_);
 }
 
 DesignDistance::~DesignDistance() = default;
 
 DesignDistance::Closest DesignDistance::closest(const Vec3& p) const {
-  // The nearest centroid's triangle bounds the distance; any closer triangle has
-  // its centroid within that bound plus the largest centroid → corner reach.
-  uint32_t t0 = 0;
-  double d2_centroid = 0;
-  index_->tree.knnSearch(p.data(), 1, &t0, &d2_centroid);
   Closest best;
-  best.triangle = t0;
-  best.point = closestPointOnTriangle(p, a_[t0], b_[t0], c_[t0]);
-  double best_d2 = (p - best.point).squaredNorm();
-  const double radius = std::sqrt(best_d2) + max_reach_m_;
-  thread_local std::vector<std::pair<uint32_t, double>> matches;
-  matches.clear();
-  nanoflann::SearchParams params;
-  params.sorted = false;
-  index_->tree.radiusSearch(p.data(), radius * radius, matches, params);
-  for (const auto& [t, d2c] : matches) {
-    if (t == t0) continue;
-    const double lower = std::sqrt(d2c) - max_reach_m_;
-    if (lower > 0 && lower * lower >= best_d2) continue;
-    const Vec3 q = closestPointOnTriangle(p, a_[t], b_[t], c_[t]);
-    const double d2 = (p - q).squaredNorm();
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      best.point = q;
-      best.triangle = t;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  const auto& nodes = index_->nodes;
+  while (top > 0) {
+    const Index::Node& n = nodes[stack[--top]];
+    if (n.box.squaredExteriorDistance(p) >= best_d2) continue;
+    if (n.count > 0) {
+      for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+        const uint32_t t = index_->order[i];
+        const Vec3 q = closestPointOnTriangle(p, a_[t], b_[t], c_[t]);
+        const double d2 = (p - q).squaredNorm();
+        if (d2 < best_d2) {
+          best_d2 = d2;
+          best.point = q;
+          best.triangle = t;
+        }
+      }
+      continue;
+    }
+    // Push the farther child first so the nearer one is searched first.
+    const double dl = nodes[n.left].box.squaredExteriorDistance(p), dr = nodes[n.right].box.squaredExteriorDistance(p);
+    if (dl < dr) {
+      if (dr < best_d2) stack[top++] = n.right;
+      stack[top++] = n.left;
+    } else {
+      if (dl < best_d2) stack[top++] = n.left;
+      stack[top++] = n.right;
     }
   }
   const double d = std::sqrt(best_d2);

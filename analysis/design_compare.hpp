@@ -47,7 +47,6 @@ class DesignDistance {
   std::vector<Vec3> a_, b_, c_;   // triangle corners
   std::vector<Vec3> normal_;      // per triangle, unit, turned to leeward
   std::vector<Vec3> centroid_;
-  double max_reach_m_ = 0;        // largest centroid → corner distance
   Vec3 leeward_ = Vec3::UnitY();
   bool cambered_ = true;
   std::vector<std::string> warnings_;

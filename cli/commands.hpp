@@ -7,5 +7,7 @@ namespace sailshape::cli {
 
 void addAnalyzeCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
+void addDesignCommand(CLI::App& app);
+void addCompareCommand(CLI::App& app);
 
 }  // namespace sailshape::cli

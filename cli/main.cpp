@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "sailshape 0.1.0");
   sailshape::cli::addAnalyzeCommand(app);
   sailshape::cli::addSimulateCommand(app);
+  sailshape::cli::addDesignCommand(app);
+  sailshape::cli::addCompareCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -223,4 +223,89 @@ TEST_F(Cli, SimulatedMainIsMeasuredWithinHalfAPercentOfCamber) {
   EXPECT_DOUBLE_EQ(sections[0]["twist_rel_deg"].get<double>(), 0.0);  // relative to the lowest section
 }
 
+// ---------------------------------------------------------------------------
+// design new / design show / compare
+
+TEST_F(Cli, DesignAndCompareHelpMentionEveryOption) {
+  Outcome r = sailshape("design new --help");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  expectMentions(r.out, {"--type", "--luff", "--leech", "--foot", "--head-width", "--tack", "--rake-deg",
+                         "--luff-round", "--luff-sag", "--leech-round", "--camber-pct", "--draft-pct", "--twist-deg",
+                         "--entry", "--exit", "--starboard", "--rows", "--columns", "--sections", "--ascii", "--out"});
+  r = sailshape("design show --help");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  expectMentions(r.out, {"FILE", "--unit", "--axes", "--sections", "--corners", "--json"});
+  r = sailshape("compare --help");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  expectMentions(r.out, {"--design", "--flying", "--sections", "--json", "--distances", "--unit", "--axes",
+                         "--params", "--no-segment", "--raw-distances", "--quiet"});
+}
+
+TEST_F(Cli, DesignNewThenShowReportsItsDimensions) {
+  const std::string obj = path("A2.obj");
+  Outcome r = sailshape("design new --type gennaker --luff 12.4 --leech 11 --foot 6.5 --camber-pct 18,24,16 --out " + obj);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(obj));
+  r = sailshape("design show " + obj + " --json " + path("show.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json doc = json::parse(readText(path("show.json")));
+  EXPECT_EQ(doc["unit"], "m");
+  EXPECT_EQ(doc["axes"], "boat");
+  EXPECT_NEAR(doc["sail"]["luff_straight_m"].get<double>(), 12.4, 0.02);
+  EXPECT_NEAR(doc["sail"]["foot_straight_m"].get<double>(), 6.5, 0.02);
+  // The generator's leech length is the planform's: twist and luff sag move the clew
+  // and head apart in 3D (11.40 m here), so the leech is not checked against 11.
+  ASSERT_EQ(doc["sections"].size(), 3u);
+  EXPECT_NEAR(doc["sections"][1]["camber_pct"].get<double>(), 24.0, 0.1);  // the mid station
+
+  r = sailshape("design new --type main --camber-pct 9,11 --out " + path("bad.obj"));
+  EXPECT_EQ(r.exit_code, 1);
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("--camber-pct"), std::string::npos) << r.err;
+  r = sailshape("design new --type main --luff -3 --out " + path("bad.obj"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(fs::exists(path("bad.obj")));
+}
+
+TEST_F(Cli, DesignShowOnTheSailcutJibMatchesItsDefinition) {
+  const std::string dxf = std::string(SAILSHAPE_SHARED) + "/sailcut-examples/Star45-JIB.dxf";
+  Outcome r = sailshape("design show " + dxf);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expectMentions(r.out, {"260 faces", "unit: millimetres (detected", "axes: sailcut", "luff", "leech", "foot"});
+  r = sailshape("design show " + dxf + " --json " + path("jib.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json doc = json::parse(readText(path("jib.json")));
+  EXPECT_EQ(doc["faces"], 260);
+  EXPECT_NEAR(doc["sail"]["luff_straight_m"].get<double>(), 1.050, 0.005);
+  EXPECT_NEAR(doc["sail"]["foot_straight_m"].get<double>(), 0.370, 0.005);
+  EXPECT_NEAR(doc["sail"]["leech_straight_m"].get<double>(), 0.940, 0.005);
+
+  const std::string broken = path("broken.dxf");
+  std::ofstream(broken) << "0\nSECTION\n2\nENTITIES\n0\n3DFACE\n10\n1.5\n20\nabc\n";
+  r = sailshape("design show " + broken);
+  EXPECT_EQ(r.exit_code, 1);
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  expectMentions(r.err, {broken, "line 10", "non-numeric"});
+}
+
+TEST_F(Cli, CompareADeeperFlyingMeshWithItsDesign) {
+  ASSERT_EQ(sailshape("design new --type main --out " + path("design.ply")).exit_code, 0);
+  ASSERT_EQ(sailshape("design new --type main --camber-pct 11,13,10 --out " + path("flying.stl")).exit_code, 0);
+  Outcome r = sailshape("compare --design " + path("design.ply") + " --flying " + path("flying.stl") +
+                        " -q --json " + path("cmp.json") + " --distances " + path("d.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json doc = json::parse(readText(path("cmp.json")));
+  EXPECT_EQ(doc["flying"]["kind"], "mesh");
+  EXPECT_GT(doc["distance"]["mean_m"].get<double>(), 0.0);  // deeper = to leeward
+  EXPECT_GT(doc["distance"]["leeward"][1].get<double>(), 0.7);
+  ASSERT_EQ(doc["sections"].size(), 3u);
+  for (const auto& s : doc["sections"]) EXPECT_NEAR(s["delta"]["camber_pct"].get<double>(), 2.0, 0.2) << s.dump();
+  EXPECT_TRUE(fs::exists(path("d.csv")));
+
+  r = sailshape("compare --design " + path("design.ply") + " --flying " + path("nothing.xyz"));
+  EXPECT_EQ(r.exit_code, 1);
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("nothing.xyz"), std::string::npos) << r.err;
+}
+
 }  // namespace

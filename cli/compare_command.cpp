@@ -1,0 +1,199 @@
+// `sailshape compare`: a flying shape (cloud or mesh) against its design.
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "analysis/analysis_json.hpp"
+#include "analysis/cloud_io.hpp"
+#include "analysis/design_compare.hpp"
+#include "analysis/design_import.hpp"
+#include "analysis/errors.hpp"
+#include "analysis/mesh_io.hpp"
+#include "analysis/params_io.hpp"
+#include "analysis/pipeline.hpp"
+#include "cli/commands.hpp"
+#include "cli/progress_bar.hpp"
+
+namespace sailshape::cli {
+namespace {
+
+struct CompareOptions {
+  std::string design, flying, unit = "auto", axes = "auto", json_out, params_file, distances_out;
+  int sections = 3;
+  bool no_segment = false, raw_distances = false, quiet = false;
+};
+
+// A .ply holds a mesh when its header declares faces.
+bool plyHasFaces(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int i = 0; i < 200 && std::getline(in, line); ++i) {
+    if (line.rfind("end_header", 0) == 0) break;
+    if (line.rfind("element face ", 0) == 0) return std::stoll("0" + line.substr(13)) > 0;
+  }
+  return false;
+}
+
+void printTable(const CompareOptions& o, const DesignImport& design, const DesignComparison& c, const std::string& what) {
+  std::printf("Design %s (%s, %s, %s axes)\nFlying %s\n", o.design.c_str(), design.format.c_str(), design.unit.c_str(),
+              design.axes.c_str(), o.flying.c_str());
+  const DistanceStats& s = c.stats;
+  std::printf("\nSigned distance of %zu %s to the design (mm, positive to leeward, towards %+.2f %+.2f %+.2f):\n",
+              s.count, what.c_str(), c.leeward.x(), c.leeward.y(), c.leeward.z());
+  std::printf("  mean %+.1f  rms %.1f  max |d| %.1f  p5 %+.1f  p50 %+.1f  p95 %+.1f\n", 1000 * s.mean_m, 1000 * s.rms_m,
+              1000 * s.max_abs_m, 1000 * s.p5_m, 1000 * s.p50_m, 1000 * s.p95_m);
+  std::printf("\nSections: design / flying (flying - design)\n");
+  std::printf("%6s %22s %22s %22s %22s %22s %22s\n", "height", "chord m", "camber %", "draft %", "twist deg",
+              "entry deg", "exit deg");
+  for (const SectionDelta& d : c.sections) {
+    auto cell = [](double a, double b, double delta, int digits) {
+      char buf[64];
+      std::snprintf(buf, sizeof(buf), "%.*f/%.*f (%+.*f)", digits, a, digits, b, digits, delta);
+      std::printf(" %22s", buf);
+    };
+    std::printf("%5.0f%%", 100 * d.fraction);
+    cell(d.design.chord_m, d.flying.chord_m, d.delta.chord_m, 3);
+    cell(d.design.camber_pct, d.flying.camber_pct, d.delta.camber_pct, 2);
+    cell(d.design.draft_pct, d.flying.draft_pct, d.delta.draft_pct, 1);
+    cell(d.design.twist_deg, d.flying.twist_deg, d.delta.twist_deg, 1);
+    cell(d.design.entry_deg, d.flying.entry_deg, d.delta.entry_deg, 1);
+    cell(d.design.exit_deg, d.flying.exit_deg, d.delta.exit_deg, 1);
+    std::printf("\n");
+  }
+  if (!c.warnings.empty()) {
+    std::printf("\nWarnings:\n");
+    for (const auto& w : c.warnings) std::printf("  %s\n", w.c_str());
+  }
+}
+
+void run(const CompareOptions& o) {
+  DesignImportOptions io;
+  io.unit = o.unit;
+  io.axes = o.axes;
+  const DesignImport design = importDesign(o.design, io);
+  SectionParams sp;
+  sp.count = o.sections;
+  MeshSections design_sections = analyzeMeshSections(design.mesh, {}, sp);
+
+  std::vector<Vec3> points;
+  SectionAnalysis flying_sections;
+  std::vector<std::string> warnings;
+  std::string what;
+  std::string ext = std::filesystem::path(o.flying).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  const bool is_mesh = ext == ".obj" || ext == ".stl" || (ext == ".ply" && plyHasFaces(o.flying));
+  ProgressBar bar(!o.quiet);
+  if (is_mesh) {
+    const Mesh flying = readMesh(o.flying);
+    OutlineParams op;
+    op.design_lengths_m = {design_sections.outline.luff_length_m, design_sections.outline.leech_length_m,
+                           design_sections.outline.foot_length_m};
+    const MeshSections fs = analyzeMeshSections(flying, op, sp);
+    flying_sections = fs.sections;
+    warnings = fs.outline.warnings;
+    points = flying.vertices;
+    what = "flying mesh vertices";
+  } else {
+    AnalysisParams params = o.params_file.empty() ? AnalysisParams{} : loadParams(o.params_file);
+    params.sections.count = o.sections;
+    params.sections.fractions.clear();
+    if (o.no_segment) params.segment = false;
+    params.outline.design_lengths_m = {design_sections.outline.luff_length_m, design_sections.outline.leech_length_m,
+                                       design_sections.outline.foot_length_m};
+    CloudReadResult read = readCloud(o.flying);
+    for (const auto& w : read.warnings) std::fprintf(stderr, "warning: %s: %s\n", o.flying.c_str(), w.c_str());
+    SailAnalysis a = analyzeSail(read.cloud, params, bar.progress());
+    flying_sections = a.sections;
+    warnings = a.warnings;
+    if (o.raw_distances) {
+      points = std::move(read.cloud.points);
+      what = "flying points (as read)";
+    } else {
+      points = std::move(a.sail_cloud.points);
+      what = "sail points (segmented, cleaned, smoothed)";
+    }
+  }
+  DesignComparison c = compareWithDesign(design.mesh, design_sections.sections, points, flying_sections, bar.progress());
+  bar.finish();
+  c.warnings.insert(c.warnings.begin(), warnings.begin(), warnings.end());
+
+  if (!o.distances_out.empty()) {
+    Cloud out;
+    out.points = points;
+    out.intensity.reserve(points.size());
+    for (double d : c.distance_m) out.intensity.push_back(static_cast<float>(1000.0 * d));
+    writeCloud(o.distances_out, out);
+    if (!o.quiet) std::fprintf(stderr, "wrote %s (intensity = signed distance, mm)\n", o.distances_out.c_str());
+  }
+  if (o.json_out.empty()) {
+    printTable(o, design, c, what);
+    return;
+  }
+  nlohmann::json doc;
+  doc["design"] = {{"file", o.design}, {"format", design.format}, {"unit", design.unit}, {"axes", design.axes},
+                   {"notes", design.notes}};
+  doc["flying"] = {{"file", o.flying}, {"kind", is_mesh ? "mesh" : "cloud"}, {"points", points.size()},
+                   {"distances_of", what}};
+  const DistanceStats& s = c.stats;
+  doc["distance"] = {{"count", s.count},       {"mean_m", s.mean_m}, {"rms_m", s.rms_m}, {"max_abs_m", s.max_abs_m},
+                     {"p5_m", s.p5_m},         {"p50_m", s.p50_m},   {"p95_m", s.p95_m},
+                     {"leeward", {c.leeward.x(), c.leeward.y(), c.leeward.z()}}};
+  doc["sections"] = nlohmann::json::array();
+  for (const SectionDelta& d : c.sections)
+    doc["sections"].push_back({{"fraction", d.fraction},
+                               {"design", sectionParametersToJson(d.design)},
+                               {"flying", sectionParametersToJson(d.flying)},
+                               {"delta", sectionParametersToJson(d.delta)}});
+  doc["warnings"] = c.warnings;
+  std::ofstream out(o.json_out);
+  if (!out) throw FileError(o.json_out + ": cannot open for writing");
+  out << doc.dump(2) << "\n";
+  if (!out) throw FileError(o.json_out + ": write failed");
+  if (!o.quiet) std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());
+}
+
+}  // namespace
+
+void addCompareCommand(CLI::App& app) {
+  auto opt = std::make_shared<CompareOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "compare",
+      "Compare a flying shape with its design, both in the boat frame: signed distance of every flying point to "
+      "the design surface (positive to the sail's leeward side, the side its camber bulges to) with its "
+      "statistics, and per-section parameter deltas (flying - design) at the same fractions.");
+  cmd->add_option("--design", opt->design, "Design file: .dxf (3DFACE), .obj, .stl or .ply mesh")->required();
+  cmd->add_option("--flying", opt->flying,
+                  "Flying shape: a cloud (.ply without faces, .pcd, .xyz/.txt, .csv; analysed by the pipeline) or a "
+                  "mesh (.obj, .stl, .ply with faces), metres, boat frame")
+      ->required();
+  cmd->add_option("--sections", opt->sections, "Number of sections N, at t = k/(N+1) of luff and leech")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--json", opt->json_out, "Write the statistics and section deltas as JSON to this file instead "
+                                           "of the table");
+  cmd->add_option("--distances", opt->distances_out,
+                  "Write the flying points with their signed distance in mm as the intensity field (.ply, .pcd, "
+                  ".xyz, .csv): the colour map");
+  cmd->add_option("--unit", opt->unit, "Design file unit: auto (mm when the largest extent exceeds 100), m, mm or cm")
+      ->check(CLI::IsMember({"auto", "m", "mm", "cm"}))
+      ->capture_default_str();
+  cmd->add_option("--axes", opt->axes,
+                  "Design file frame: auto (sailcut for DXF and Y-up meshes, else boat), boat or sailcut (X tack to "
+                  "clew, Y up, Z depth)")
+      ->check(CLI::IsMember({"auto", "boat", "sailcut"}))
+      ->capture_default_str();
+  cmd->add_option("--params", opt->params_file, "Pipeline parameters file for a flying cloud (see analyze "
+                                                "--print-params)");
+  cmd->add_flag("--no-segment", opt->no_segment, "The flying cloud is the sail alone: skip segmentation");
+  cmd->add_flag("--raw-distances", opt->raw_distances,
+                "Distances of every flying point as read, not of the analysed (segmented, cleaned, smoothed) sail "
+                "points");
+  cmd->add_flag("-q,--quiet", opt->quiet, "No progress output");
+  cmd->callback([opt] { run(*opt); });
+}
+
+}  // namespace sailshape::cli
