@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <unordered_map>
 
 #include "analysis/errors.hpp"
 
@@ -29,6 +30,55 @@ class StageTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
+// One point per occupied voxel (the centroid), and each input point's voxel.
+struct VoxelSample {
+  Cloud cloud;
+  std::vector<uint32_t> voxel_of;
+};
+
+VoxelSample voxelSample(const Cloud& in, double voxel) {
+  VoxelSample out;
+  out.cloud.viewpoint = in.viewpoint;
+  out.voxel_of.resize(in.size());
+  std::unordered_map<int64_t, uint32_t> index;
+  index.reserve(in.size() / 2 + 1);
+  std::vector<Vec3> sum;
+  std::vector<uint32_t> count;
+  for (size_t i = 0; i < in.size(); ++i) {
+    const Vec3& p = in.points[i];
+    const int64_t key = (static_cast<int64_t>(std::floor(p.x() / voxel)) * 73856093) ^
+                        (static_cast<int64_t>(std::floor(p.y() / voxel)) * 19349663) ^
+                        (static_cast<int64_t>(std::floor(p.z() / voxel)) * 83492791);
+    auto [it, fresh] = index.emplace(key, static_cast<uint32_t>(sum.size()));
+    if (fresh) {
+      sum.push_back(Vec3::Zero());
+      count.push_back(0);
+    }
+    sum[it->second] += p;
+    ++count[it->second];
+    out.voxel_of[i] = it->second;
+  }
+  out.cloud.points.resize(sum.size());
+  for (size_t v = 0; v < sum.size(); ++v) out.cloud.points[v] = sum[v] / static_cast<double>(count[v]);
+  return out;
+}
+
+// Median nearest-neighbour distance over a sample of up to 512 points, m.
+double medianSpacingEstimate(const std::vector<Vec3>& pts) {
+  if (pts.size() < 2) return 0;
+  KdTree tree(pts);
+  std::vector<double> d;
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  const size_t step = std::max<size_t>(1, pts.size() / 512);
+  for (size_t i = 0; i < pts.size(); i += step) {
+    tree.nearest(pts[i], 2, idx, d2);
+    d.push_back(std::sqrt(d2.back()));
+  }
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
 }  // namespace
 
 SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
@@ -44,13 +94,26 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
 
   if (p.segment) {
     StageTimer t(a, "segmentation", cloud.size());
+    // Work on a voxel-grid sample when the scan is denser than the voxel.
+    const double voxel = p.segmentation_voxel_sigmas * p.sensor_sigma_m;
+    VoxelSample sample;
+    const bool thin = voxel > 0 && medianSpacingEstimate(cloud.points) < 0.8 * voxel;
+    if (thin) sample = voxelSample(cloud, voxel);
+    const Cloud& seg_cloud = thin ? sample.cloud : cloud;
     const size_t k = static_cast<size_t>(std::max(p.normals.k_neighbours, p.region_growing.k_neighbours));
-    const NeighbourTable table = nearestNeighbours(cloud.points, k, progress);
-    const NormalEstimation normals = estimateNormals(cloud, table, p.normals, progress);
-    const Segmentation seg = growRegions(cloud, normals.normals, table, p.region_growing, progress);
-    const SailPick pick = pickSailCluster(cloud, seg, p.sail_pick);
+    const NeighbourTable table = nearestNeighbours(seg_cloud.points, k, progress);
+    const NormalEstimation normals = estimateNormals(seg_cloud, table, p.normals, progress);
+    const Segmentation seg = growRegions(seg_cloud, normals.normals, table, p.region_growing, progress);
+    const SailPick pick = pickSailCluster(seg_cloud, seg, p.sail_pick);
     a.clusters = pick.candidates;
-    const std::vector<uint32_t> idx = addClusterFringe(seg, pick.cluster, table);
+    std::vector<uint32_t> idx = addClusterFringe(seg, pick.cluster, table);
+    if (thin) {
+      std::vector<char> in(sample.cloud.size(), 0);
+      for (uint32_t v : idx) in[v] = 1;
+      idx.clear();
+      for (uint32_t i = 0; i < cloud.size(); ++i)
+        if (in[sample.voxel_of[i]]) idx.push_back(i);
+    }
     cloud = selectPoints(cloud, idx);
     std::vector<std::string> w = normals.warnings;
     w.insert(w.end(), seg.warnings.begin(), seg.warnings.end());

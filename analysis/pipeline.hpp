@@ -22,6 +22,10 @@ struct AnalysisParams {
   double sensor_sigma_m = 0.004;   // SPEC §3; feeds smoothing classes and uncertainties
   NormalParams normals;
   bool segment = true;             // false: the cloud is the sail alone, skip segmentation
+  // Segmentation runs on a voxel-grid sample this many sensor σ wide when the
+  // scan is denser (0: full resolution), so normals and curvature see the same
+  // neighbourhood size relative to the noise whatever the scanner's density.
+  double segmentation_voxel_sigmas = 5.0;
   RegionGrowingParams region_growing;
   SailPickParams sail_pick;
   bool statistical_outliers = true;

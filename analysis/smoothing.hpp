@@ -17,6 +17,11 @@ struct SmoothingParams {
   // over 10 % of a short chord, while a sail curves too gently to be flattened.
   int k_neighbours = 200;
   int polynomial_order = 2;     // 1: plane, 2: quadratic
+  // 0: a local surface fitted at every point (MLS proper). > 0: surfaces fitted
+  // at anchors about anchor_ratio × the neighbourhood radius apart, each point
+  // projected onto a blend of its nearest anchors' (several times faster, a
+  // little less precise at edges and corners).
+  double anchor_ratio = 0.0;
   double good_m = 0.004;        // sensor random error σ (SPEC §3)
   double fair_m = 0.009;        // σ + systematic error: 9 mm at model scale, 14 mm full scale
 };

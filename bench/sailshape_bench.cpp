@@ -1,0 +1,294 @@
+// Benchmark: each analysis stage and the whole analysis, ours against PCL's
+// stock classes on the same synthetic sails (4 mm range noise, SPEC §3), at
+// 50,000, 200,000 and 1,000,000 points. Counters: points per second, peak
+// resident memory, and for the whole analysis the section-parameter errors
+// against the generator's known answer (stock PCL has no section analysis).
+#include <benchmark/benchmark.h>
+#include <pcl/features/normal_3d.h>
+#include <pcl/filters/statistical_outlier_removal.h>
+#include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
+#include <pcl/segmentation/region_growing.h>
+#include <pcl/surface/gp3.h>
+#include <pcl/surface/mls.h>
+#include <sys/resource.h>
+
+#include <cmath>
+#include <map>
+
+#include "analysis/cleaning.hpp"
+#include "analysis/normals.hpp"
+#include "analysis/pipeline.hpp"
+#include "analysis/sail_generator.hpp"
+#include "analysis/segmentation.hpp"
+#include "analysis/smoothing.hpp"
+#include "analysis/surface.hpp"
+
+namespace {
+
+using namespace sailshape;
+
+const Cloud& sail(size_t points) {
+  static std::map<size_t, Cloud> cache;
+  auto it = cache.find(points);
+  if (it == cache.end()) {
+    ScanSimulation sim;
+    sim.points = points;
+    sim.noise_sigma_m = 0.004;
+    sim.seed = 7;
+    it = cache.emplace(points, sampleSail(exampleDesign(SailType::Main), sim)).first;
+  }
+  return it->second;
+}
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const Cloud& c) {
+  auto out = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  out->reserve(c.size());
+  for (const Vec3& p : c.points) out->push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                                             static_cast<float>(p.z())));
+  return out;
+}
+
+double peakMemoryMiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+void finish(benchmark::State& state, size_t points) {
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * points));
+  state.counters["peak_MiB"] = peakMemoryMiB();
+}
+
+// ---- normals ----
+void BM_Ours_Normals(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(estimateNormals(c, NormalParams{}));
+  finish(state, c.size());
+}
+void BM_Pcl_Normals(benchmark::State& state) {
+  const auto pc = toPcl(sail(static_cast<size_t>(state.range(0))));
+  for (auto _ : state) {
+    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+    ne.setInputCloud(pc);
+    ne.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+    ne.setKSearch(NormalParams{}.k_neighbours);
+    pcl::PointCloud<pcl::Normal> normals;
+    ne.compute(normals);
+    benchmark::DoNotOptimize(normals.size());
+  }
+  finish(state, pc->size());
+}
+
+// ---- region growing ----
+void BM_Ours_RegionGrowing(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  const AnalysisParams p;
+  for (auto _ : state) {
+    const NeighbourTable table = nearestNeighbours(c.points, static_cast<size_t>(p.region_growing.k_neighbours));
+    const NormalEstimation n = estimateNormals(c, table, p.normals);
+    benchmark::DoNotOptimize(growRegions(c, n.normals, table, p.region_growing));
+  }
+  finish(state, c.size());
+}
+void BM_Pcl_RegionGrowing(benchmark::State& state) {
+  const auto pc = toPcl(sail(static_cast<size_t>(state.range(0))));
+  const AnalysisParams p;
+  for (auto _ : state) {
+    auto tree = pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+    ne.setInputCloud(pc);
+    ne.setSearchMethod(tree);
+    ne.setKSearch(p.normals.k_neighbours);
+    auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
+    ne.compute(*normals);
+    pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
+    rg.setInputCloud(pc);
+    rg.setInputNormals(normals);
+    rg.setSearchMethod(tree);
+    rg.setNumberOfNeighbours(p.region_growing.k_neighbours);
+    rg.setSmoothnessThreshold(static_cast<float>(p.region_growing.max_normal_angle_deg / 180.0 * M_PI));
+    rg.setCurvatureThreshold(static_cast<float>(p.region_growing.max_curvature));
+    rg.setMinClusterSize(static_cast<pcl::uindex_t>(p.region_growing.min_points));
+    std::vector<pcl::PointIndices> clusters;
+    rg.extract(clusters);
+    benchmark::DoNotOptimize(clusters.size());
+  }
+  finish(state, pc->size());
+}
+
+// ---- statistical outliers ----
+void BM_Ours_StatisticalOutliers(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(removeStatisticalOutliers(c));
+  finish(state, c.size());
+}
+void BM_Pcl_StatisticalOutliers(benchmark::State& state) {
+  const auto pc = toPcl(sail(static_cast<size_t>(state.range(0))));
+  const StatisticalOutlierParams p;
+  for (auto _ : state) {
+    pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
+    sor.setInputCloud(pc);
+    sor.setMeanK(p.k_neighbours);
+    sor.setStddevMulThresh(p.std_ratio);
+    pcl::PointCloud<pcl::PointXYZ> out;
+    sor.filter(out);
+    benchmark::DoNotOptimize(out.size());
+  }
+  finish(state, pc->size());
+}
+
+// ---- moving least squares ----
+void BM_Ours_Mls(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(smoothMls(c));
+  finish(state, c.size());
+}
+void BM_Pcl_Mls(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  const auto pc = toPcl(c);
+  // A radius holding about 60 neighbours at this density.
+  const double area = 18.0;  // m², the example mainsail
+  const double radius = std::sqrt(60.0 / (M_PI * static_cast<double>(c.size()) / area));
+  for (auto _ : state) {
+    pcl::MovingLeastSquares<pcl::PointXYZ, pcl::PointXYZ> mls;
+    mls.setInputCloud(pc);
+    mls.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+    mls.setSearchRadius(radius);
+    mls.setPolynomialOrder(2);
+    pcl::PointCloud<pcl::PointXYZ> out;
+    mls.process(out);
+    benchmark::DoNotOptimize(out.size());
+  }
+  finish(state, pc->size());
+}
+
+// ---- surface ----
+void BM_Ours_Surface(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(reconstructSurface(c));
+  finish(state, c.size());
+}
+void BM_Pcl_GreedyProjection(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  const auto pc = toPcl(c);
+  for (auto _ : state) {
+    auto tree = pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+    ne.setInputCloud(pc);
+    ne.setSearchMethod(tree);
+    ne.setKSearch(20);
+    pcl::PointCloud<pcl::Normal> normals;
+    ne.compute(normals);
+    auto with_normals = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>>();
+    pcl::concatenateFields(*pc, normals, *with_normals);
+    pcl::GreedyProjectionTriangulation<pcl::PointNormal> gp3;
+    const double spacing = std::sqrt(18.0 / static_cast<double>(c.size()));
+    gp3.setSearchRadius(5 * spacing);
+    gp3.setMu(2.5);
+    gp3.setMaximumNearestNeighbors(100);
+    gp3.setInputCloud(with_normals);
+    gp3.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointNormal>>());
+    pcl::PolygonMesh mesh;
+    gp3.reconstruct(mesh);
+    benchmark::DoNotOptimize(mesh.polygons.size());
+  }
+  finish(state, pc->size());
+}
+
+// ---- whole analysis ----
+void BM_Ours_WholeAnalysis(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  const SailSurface truth(exampleDesign(SailType::Main));
+  double camber = 0, draft = 0, twist = 0, ends = 0;
+  for (auto _ : state) {
+    const SailAnalysis a = analyzeSail(c);
+    for (const Section& s : a.sections.sections) {
+      const KnownSection k = truth.section(s.fraction);
+      camber = std::max(camber, std::abs(s.value.camber_pct - k.camber_pct));
+      draft = std::max(draft, std::abs(s.value.draft_pct - k.draft_pct));
+      twist = std::max(twist, std::abs(s.value.twist_deg - k.twist_deg));
+      ends = std::max({ends, std::abs(s.value.entry_deg - k.entry_deg), std::abs(s.value.exit_deg - k.exit_deg)});
+    }
+  }
+  state.counters["err_camber_pct"] = camber;
+  state.counters["err_draft_pct"] = draft;
+  state.counters["err_twist_deg"] = twist;
+  state.counters["err_entry_exit_deg"] = ends;
+  finish(state, c.size());
+}
+// The same chain with PCL's stock classes: normals → region growing → SOR →
+// MLS → greedy projection (no outline or section analysis exists in PCL).
+void BM_Pcl_WholeAnalysis(benchmark::State& state) {
+  const size_t n = static_cast<size_t>(state.range(0));
+  for (auto _ : state) {
+    benchmark::State* s = &state;
+    (void)s;
+    const auto pc = toPcl(sail(n));
+    const AnalysisParams p;
+    auto tree = pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+    ne.setInputCloud(pc);
+    ne.setSearchMethod(tree);
+    ne.setKSearch(p.normals.k_neighbours);
+    auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
+    ne.compute(*normals);
+    pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
+    rg.setInputCloud(pc);
+    rg.setInputNormals(normals);
+    rg.setSearchMethod(tree);
+    rg.setNumberOfNeighbours(p.region_growing.k_neighbours);
+    rg.setSmoothnessThreshold(static_cast<float>(p.region_growing.max_normal_angle_deg / 180.0 * M_PI));
+    rg.setCurvatureThreshold(static_cast<float>(p.region_growing.max_curvature));
+    std::vector<pcl::PointIndices> clusters;
+    rg.extract(clusters);
+    auto sail_pts = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    size_t best = 0;
+    for (size_t i = 1; i < clusters.size(); ++i)
+      if (clusters[i].indices.size() > clusters[best].indices.size()) best = i;
+    if (!clusters.empty())
+      for (int i : clusters[best].indices) sail_pts->push_back((*pc)[static_cast<size_t>(i)]);
+    pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
+    sor.setInputCloud(sail_pts);
+    sor.setMeanK(p.statistical.k_neighbours);
+    sor.setStddevMulThresh(p.statistical.std_ratio);
+    auto cleaned = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    sor.filter(*cleaned);
+    pcl::MovingLeastSquares<pcl::PointXYZ, pcl::PointNormal> mls;
+    mls.setInputCloud(cleaned);
+    mls.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+    mls.setSearchRadius(std::sqrt(60.0 / (M_PI * static_cast<double>(n) / 18.0)));
+    mls.setPolynomialOrder(2);
+    mls.setComputeNormals(true);
+    auto smoothed = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>>();
+    mls.process(*smoothed);
+    pcl::GreedyProjectionTriangulation<pcl::PointNormal> gp3;
+    gp3.setSearchRadius(5 * std::sqrt(18.0 / static_cast<double>(n)));
+    gp3.setMu(2.5);
+    gp3.setMaximumNearestNeighbors(100);
+    gp3.setInputCloud(smoothed);
+    gp3.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointNormal>>());
+    pcl::PolygonMesh mesh;
+    gp3.reconstruct(mesh);
+    benchmark::DoNotOptimize(mesh.polygons.size());
+  }
+  finish(state, n);
+}
+
+#define SIZES Arg(50'000)->Arg(200'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->Iterations(1)
+BENCHMARK(BM_Ours_Normals)->SIZES;
+BENCHMARK(BM_Pcl_Normals)->SIZES;
+BENCHMARK(BM_Ours_RegionGrowing)->SIZES;
+BENCHMARK(BM_Pcl_RegionGrowing)->SIZES;
+BENCHMARK(BM_Ours_StatisticalOutliers)->SIZES;
+BENCHMARK(BM_Pcl_StatisticalOutliers)->SIZES;
+BENCHMARK(BM_Ours_Mls)->SIZES;
+BENCHMARK(BM_Pcl_Mls)->SIZES;
+BENCHMARK(BM_Ours_Surface)->SIZES;
+BENCHMARK(BM_Pcl_GreedyProjection)->SIZES;
+BENCHMARK(BM_Ours_WholeAnalysis)->SIZES;
+BENCHMARK(BM_Pcl_WholeAnalysis)->SIZES;
+
+}  // namespace
+
+BENCHMARK_MAIN();
