@@ -17,6 +17,7 @@
 #include <map>
 
 #include "analysis/cleaning.hpp"
+#include "analysis/design_compare.hpp"
 #include "analysis/normals.hpp"
 #include "analysis/pipeline.hpp"
 #include "analysis/sail_generator.hpp"
@@ -275,6 +276,18 @@ void BM_Pcl_WholeAnalysis(benchmark::State& state) {
   finish(state, n);
 }
 
+// ---- design vs flying: signed distance of the flying points to a ~50,000-triangle design ----
+void BM_Ours_SignedDistance(benchmark::State& state) {
+  const Cloud& c = sail(static_cast<size_t>(state.range(0)));
+  SailDesign design = exampleDesign(SailType::Main);
+  design.stations[1].camber_pct -= 2;  // the flying shape differs from its design
+  const Mesh mesh = generateSailMesh(design, 250, 100);  // 50,000 triangles
+  const DesignDistance distance(mesh);
+  for (auto _ : state) benchmark::DoNotOptimize(signedDistances(distance, c.points));
+  state.counters["design_triangles"] = static_cast<double>(mesh.triangles.size());
+  finish(state, c.size());
+}
+
 #define SIZES Arg(50'000)->Arg(200'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->Iterations(1)
 BENCHMARK(BM_Ours_Normals)->SIZES;
 BENCHMARK(BM_Pcl_Normals)->SIZES;
@@ -288,6 +301,7 @@ BENCHMARK(BM_Ours_Surface)->SIZES;
 BENCHMARK(BM_Pcl_GreedyProjection)->SIZES;
 BENCHMARK(BM_Ours_WholeAnalysis)->SIZES;
 BENCHMARK(BM_Pcl_WholeAnalysis)->SIZES;
+BENCHMARK(BM_Ours_SignedDistance)->SIZES;
 
 }  // namespace
 
