@@ -1,0 +1,221 @@
+#include "database/sqlite.hpp"
+
+#include <sqlite3.h>
+
+#include <utility>
+
+namespace sailshape {
+namespace {
+
+std::string describe(sqlite3* db, int rc) {
+  std::string msg = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
+  return msg + " (" + sqlite3_errstr(rc) + ", code " + std::to_string(rc) + ")";
+}
+
+}  // namespace
+
+void Database::check(int rc, const char* what) const {
+  if (rc == SQLITE_OK || rc == SQLITE_ROW || rc == SQLITE_DONE) return;
+  const int primary = rc & 0xff;
+  if (primary == SQLITE_BUSY || primary == SQLITE_LOCKED)
+    throw DatabaseBusy(std::string("[") + what + "] " + path_ + ": database is locked by another connection (waited " +
+                       std::to_string(busy_timeout_ms_) + " ms): " + describe(db_, rc));
+  if (primary == SQLITE_NOTADB)
+    throw DatabaseError(std::string("[") + what + "] " + path_ + ": not an SQLite database (or encrypted); left untouched");
+  if (primary == SQLITE_CORRUPT)
+    throw DatabaseError(std::string("[") + what + "] " + path_ + ": database file is damaged: " + describe(db_, rc));
+  throw DatabaseError(std::string("[") + what + "] " + path_ + ": " + describe(db_, rc));
+}
+
+Database::Database(const std::string& path, const OpenOptions& options)
+    : path_(path), busy_timeout_ms_(options.busy_timeout_ms) {
+  if (options.busy_timeout_ms < 0)
+    throw DatabaseError("[Database] busy_timeout_ms must be >= 0 (got " + std::to_string(options.busy_timeout_ms) + ")");
+  int flags = options.read_only ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE;
+  if (options.create && !options.read_only) flags |= SQLITE_OPEN_CREATE;
+  flags |= SQLITE_OPEN_NOMUTEX;
+  const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr);
+  if (rc != SQLITE_OK) {
+    const std::string msg = describe(db_, rc);
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw DatabaseError("[Database] " + path + ": cannot open: " + msg);
+  }
+  try {
+    sqlite3_extended_result_codes(db_, 1);
+    check(sqlite3_busy_timeout(db_, options.busy_timeout_ms), "Database");
+    // A read first: SQLite opens files lazily, and a foreign file must be
+    // refused before any pragma could write to it.
+    exec("SELECT count(*) FROM sqlite_schema");
+    if (!options.read_only) exec("PRAGMA journal_mode=WAL");
+    exec("PRAGMA foreign_keys=ON");
+    exec("PRAGMA synchronous=NORMAL");  // durable with WAL up to the last checkpointed commit; never corrupt
+  } catch (...) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw;
+  }
+}
+
+Database::~Database() {
+  if (db_) sqlite3_close_v2(db_);
+}
+
+Database::Database(Database&& other) noexcept
+    : db_(std::exchange(other.db_, nullptr)), path_(std::move(other.path_)), busy_timeout_ms_(other.busy_timeout_ms_) {}
+
+Database& Database::operator=(Database&& other) noexcept {
+  if (this != &other) {
+    if (db_) sqlite3_close_v2(db_);
+    db_ = std::exchange(other.db_, nullptr);
+    path_ = std::move(other.path_);
+    busy_timeout_ms_ = other.busy_timeout_ms_;
+  }
+  return *this;
+}
+
+void Database::exec(const std::string& sql) {
+  char* err = nullptr;
+  const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err);
+  sqlite3_free(err);
+  check(rc, "Database::exec");
+}
+
+Statement Database::prepare(const std::string& sql) { return Statement(*this, sql); }
+
+int64_t Database::lastInsertId() const { return sqlite3_last_insert_rowid(db_); }
+
+int Database::userVersion() {
+  Statement s(*this, "PRAGMA user_version");
+  s.step();
+  return static_cast<int>(s.columnInt(0));
+}
+
+void Database::setUserVersion(int version) { exec("PRAGMA user_version=" + std::to_string(version)); }
+
+std::vector<std::string> Database::integrityCheck() {
+  std::vector<std::string> problems;
+  Statement s(*this, "PRAGMA integrity_check");
+  while (s.step()) {
+    std::string line = s.columnText(0);
+    if (line != "ok") problems.push_back(line);
+  }
+  Statement fk(*this, "PRAGMA foreign_key_check");
+  while (fk.step())
+    problems.push_back("foreign key: row " + fk.columnText(1) + " of " + fk.columnText(0) + " refers to a missing row of " +
+                       fk.columnText(2));
+  return problems;
+}
+
+void Database::backupTo(const std::string& dest_path) {
+  sqlite3* dest = nullptr;
+  int rc = sqlite3_open_v2(dest_path.c_str(), &dest, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  if (rc != SQLITE_OK) {
+    const std::string msg = describe(dest, rc);
+    sqlite3_close(dest);
+    throw DatabaseError("[Database::backupTo] " + dest_path + ": cannot open: " + msg);
+  }
+  sqlite3_busy_timeout(dest, busy_timeout_ms_);
+  sqlite3_backup* b = sqlite3_backup_init(dest, "main", db_, "main");
+  if (!b) {
+    const std::string msg = sqlite3_errmsg(dest);
+    sqlite3_close(dest);
+    throw DatabaseError("[Database::backupTo] " + dest_path + ": " + msg);
+  }
+  // Pages in steps so writers on the source are not held up for the whole copy.
+  do {
+    rc = sqlite3_backup_step(b, 256);
+    if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) sqlite3_sleep(10);
+  } while (rc == SQLITE_OK || rc == SQLITE_BUSY || rc == SQLITE_LOCKED);
+  sqlite3_backup_finish(b);
+  const int final_rc = sqlite3_errcode(dest);
+  const std::string msg = describe(dest, rc);
+  sqlite3_close(dest);
+  if (rc != SQLITE_DONE || (final_rc != SQLITE_OK && final_rc != SQLITE_DONE))
+    throw DatabaseError("[Database::backupTo] " + path_ + " -> " + dest_path + ": " + msg);
+}
+
+Statement::Statement(Database& db, const std::string& sql) : db_(&db), sql_(sql) {
+  db_->check(sqlite3_prepare_v2(db.handle(), sql.c_str(), static_cast<int>(sql.size()), &stmt_, nullptr),
+             "Statement::prepare");
+}
+
+Statement::~Statement() {
+  if (stmt_) sqlite3_finalize(stmt_);
+}
+
+Statement::Statement(Statement&& other) noexcept
+    : db_(other.db_), stmt_(std::exchange(other.stmt_, nullptr)), sql_(std::move(other.sql_)) {}
+
+Statement& Statement::bind(int index, int64_t value) {
+  db_->check(sqlite3_bind_int64(stmt_, index, value), "Statement::bind");
+  return *this;
+}
+Statement& Statement::bind(int index, double value) {
+  db_->check(sqlite3_bind_double(stmt_, index, value), "Statement::bind");
+  return *this;
+}
+Statement& Statement::bind(int index, const std::string& value) {
+  db_->check(sqlite3_bind_text(stmt_, index, value.data(), static_cast<int>(value.size()), SQLITE_TRANSIENT),
+             "Statement::bind");
+  return *this;
+}
+Statement& Statement::bind(int index, const std::optional<double>& value) {
+  return value ? bind(index, *value) : bindNull(index);
+}
+Statement& Statement::bindBlob(int index, const std::vector<uint8_t>& value) {
+  db_->check(sqlite3_bind_blob64(stmt_, index, value.data(), value.size(), SQLITE_TRANSIENT), "Statement::bind");
+  return *this;
+}
+Statement& Statement::bindNull(int index) {
+  db_->check(sqlite3_bind_null(stmt_, index), "Statement::bind");
+  return *this;
+}
+
+bool Statement::step() {
+  const int rc = sqlite3_step(stmt_);
+  if (rc == SQLITE_ROW) return true;
+  if (rc == SQLITE_DONE) return false;
+  sqlite3_reset(stmt_);
+  db_->check(rc, "Statement::step");
+  return false;
+}
+
+void Statement::run() {
+  while (step()) {
+  }
+}
+
+void Statement::reset() {
+  sqlite3_reset(stmt_);
+  sqlite3_clear_bindings(stmt_);
+}
+
+int Statement::columnCount() const { return sqlite3_column_count(stmt_); }
+std::string Statement::columnName(int c) const { return sqlite3_column_name(stmt_, c); }
+bool Statement::isNull(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_NULL; }
+bool Statement::isInteger(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_INTEGER; }
+bool Statement::isFloat(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_FLOAT; }
+int64_t Statement::columnInt(int c) const { return sqlite3_column_int64(stmt_, c); }
+double Statement::columnDouble(int c) const { return sqlite3_column_double(stmt_, c); }
+std::string Statement::columnText(int c) const {
+  const unsigned char* t = sqlite3_column_text(stmt_, c);
+  return t ? std::string(reinterpret_cast<const char*>(t), sqlite3_column_bytes(stmt_, c)) : std::string();
+}
+std::vector<uint8_t> Statement::columnBlob(int c) const {
+  const auto* p = static_cast<const uint8_t*>(sqlite3_column_blob(stmt_, c));
+  return p ? std::vector<uint8_t>(p, p + sqlite3_column_bytes(stmt_, c)) : std::vector<uint8_t>();
+}
+
+Transaction::Transaction(Database& db) : db_(db) { db_.exec("BEGIN IMMEDIATE"); }
+
+Transaction::~Transaction() {
+  if (!done_) sqlite3_exec(db_.handle(), "ROLLBACK", nullptr, nullptr, nullptr);
+}
+
+void Transaction::commit() {
+  db_.exec("COMMIT");
+  done_ = true;
+}
+
+}  // namespace sailshape
