@@ -1,0 +1,213 @@
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <random>
+
+#include "analysis/errors.hpp"
+#include "database/cloud_blob.hpp"
+#include "database/import.hpp"
+#include "database/schema.hpp"
+#include "db_fixture.hpp"
+
+namespace sailshape {
+namespace {
+
+using test::analysisDoc;
+using test::TempDir;
+
+int64_t count(Database& db, const std::string& sql) {
+  Statement s = db.prepare(sql);
+  s.step();
+  return s.columnInt(0);
+}
+
+Cloud noisyCloud(size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  Cloud c;
+  for (size_t i = 0; i < n; ++i) {
+    const double u = double(i % 200) / 200, v = double(i / 200) / (n / 200 + 1);
+    c.points.emplace_back(3 * u, 0.3 * u * (1 - u) + noise(rng), 8 * v);
+    c.intensity.push_back(float(i % 97));
+  }
+  return c;
+}
+
+ImportMetadata meta(int step, double awa) {
+  ImportMetadata m;
+  m.campaign = "Lorient 2025";
+  m.boat = "Alpha";
+  m.sail = "Gen-A";
+  m.sail_type = "genoa";
+  m.test = "sheet sweep";
+  m.trim_step = step;
+  m.awa_deg = awa;
+  m.aws_m_s = 8.0;
+  m.drive_n = 100.0 + step;
+  m.side_n = 50.0;
+  m.controls = {{"sheet", 0.1 * step}, {"tack_height", 0.5}};
+  m.pressures_pa = {{"tap01", -120.0}};
+  m.scanner_unit = "LMS511-1";
+  m.scanned_at = "2025-06-01T10:00:00Z";
+  m.settings = {{"frequency_hz", 25}};
+  return m;
+}
+
+TEST(CloudBlob, RoundTripsPointsAndIntensity) {
+  const Cloud c = noisyCloud(5000, 1);
+  const std::vector<uint8_t> blob = compressCloud(c);
+  EXPECT_LT(blob.size(), c.size() * 16);
+  const Cloud d = decompressCloud(blob);
+  ASSERT_EQ(d.size(), c.size());
+  ASSERT_EQ(d.intensity.size(), c.size());
+  for (size_t i = 0; i < c.size(); i += 37) {
+    EXPECT_NEAR((d.points[i] - c.points[i]).norm(), 0.0, 1e-5);  // float32 at ≤ 10 m
+    EXPECT_EQ(d.intensity[i], c.intensity[i]);
+  }
+  EXPECT_THROW(decompressCloud({1, 2, 3}), DatabaseError);
+  std::vector<uint8_t> bad = blob;
+  bad.resize(bad.size() / 2);
+  EXPECT_THROW(decompressCloud(bad), DatabaseError);
+}
+
+TEST(Import, StoresAnalysisTrimStepAndCloudInOneTransaction) {
+  TempDir dir;
+  Database db = openSailDatabase(dir.file("a.db"));
+  const nlohmann::json doc = analysisDoc(8.0);
+  const Cloud cloud = noisyCloud(2000, 2);
+  const ImportResult r = importScan(db, meta(1, 90.0), &doc, &cloud);
+  EXPECT_EQ(r.sections, 3u);
+  EXPECT_GT(r.analysis_id, 0);
+
+  Statement s = db.prepare("SELECT point_count, cloud, settings, unit_id IS NOT NULL FROM scans WHERE id = ?");
+  s.bind(1, r.scan_id);
+  ASSERT_TRUE(s.step());
+  EXPECT_EQ(s.columnInt(0), 2000);
+  EXPECT_EQ(decompressCloud(s.columnBlob(1)).size(), 2000u);
+  EXPECT_EQ(nlohmann::json::parse(s.columnText(2))["frequency_hz"], 25);
+  EXPECT_EQ(s.columnInt(3), 1);
+
+  Statement x = db.prepare("SELECT fraction, camber_pct, u_camber_pct, exit_deg, curve FROM sections WHERE analysis_id = ? ORDER BY fraction");
+  x.bind(1, r.analysis_id);
+  ASSERT_TRUE(x.step());
+  EXPECT_DOUBLE_EQ(x.columnDouble(0), 0.25);
+  EXPECT_DOUBLE_EQ(x.columnDouble(1), 8.0);
+  EXPECT_DOUBLE_EQ(x.columnDouble(2), 0.2);
+  EXPECT_TRUE(x.isNull(3));  // null in the JSON: not measurable
+  const auto curve = unpackCurve(x.columnBlob(4));
+  ASSERT_EQ(curve.size(), 3u);
+  EXPECT_DOUBLE_EQ(curve[1].x(), 1.0);
+  EXPECT_DOUBLE_EQ(curve[1].z(), 0.25);
+
+  EXPECT_EQ(count(db, "SELECT count(*) FROM control_settings"), 2);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM pressures"), 1);
+  Statement a = db.prepare("SELECT diagnostics, software_version FROM analyses");
+  ASSERT_TRUE(a.step());
+  EXPECT_EQ(nlohmann::json::parse(a.columnText(0))["points_in"], 50000);
+  EXPECT_EQ(a.columnText(1), "0.1.0");
+
+  // A second scan of the same trim step reuses it (and its campaign, sail, ...).
+  const ImportResult r2 = importScan(db, meta(1, 90.0), &doc);
+  EXPECT_EQ(r2.trim_step_id, r.trim_step_id);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM trim_steps"), 1);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM campaigns"), 1);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 2);
+  EXPECT_EQ(count(db, "SELECT point_count FROM scans WHERE id = " + std::to_string(r2.scan_id)), 50000);
+}
+
+TEST(Import, BadInputThrowsAndStoresNothing) {
+  TempDir dir;
+  Database db = openSailDatabase(dir.file("a.db"));
+  const nlohmann::json doc = analysisDoc(8.0);
+  const nlohmann::json not_analysis = {{"points", 3}};
+  EXPECT_THROW(importScan(db, meta(0, 90), &not_analysis), InvalidInput);
+  EXPECT_THROW(importScan(db, meta(0, 90), nullptr, nullptr), InvalidInput);
+  ImportMetadata m = meta(0, 90);
+  m.campaign_kind = "lake";
+  EXPECT_THROW(importScan(db, m, &doc), InvalidInput);
+  m = meta(0, 400);
+  EXPECT_THROW(importScan(db, m, &doc), InvalidInput);
+  m = meta(0, 90);
+  m.sail.clear();
+  EXPECT_THROW(importScan(db, m, &doc), InvalidInput);
+  // A bad section is found after the trim step and scan rows were written: the
+  // transaction rolls all of them back.
+  nlohmann::json bad = analysisDoc(8.0);
+  bad["sections"][2]["fraction"] = 1.5;
+  EXPECT_THROW(importScan(db, meta(0, 90), &bad), InvalidInput);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 0);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM trim_steps"), 0);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM campaigns"), 0);
+}
+
+TEST(Import, WriterKilledMidImportLeavesFileConsistentAndScanAbsent) {
+  TempDir dir;
+  const std::string path = dir.file("a.db");
+  const nlohmann::json doc = analysisDoc(8.0);
+  int64_t first_scan = 0;
+  {
+    Database db = openSailDatabase(path);
+    first_scan = importScan(db, meta(0, 90.0), &doc).scan_id;
+  }  // closed before fork: a connection must not cross it
+
+  int ready[2];
+  ASSERT_EQ(pipe(ready), 0);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    close(ready[0]);
+    try {
+      Database db = openSailDatabase(path);
+      db.exec("PRAGMA cache_size=-64");  // 64 KiB: uncommitted pages spill into the WAL file
+      const Cloud cloud = noisyCloud(200000, 3);
+      importScan(db, meta(1, 95.0), &doc, &cloud, [&](const std::string& stage) {
+        if (stage != "sections") return;
+        const char c = 'k';
+        if (write(ready[1], &c, 1) != 1) _exit(3);
+        for (;;) pause();  // every row written, nothing committed: wait for SIGKILL
+      });
+    } catch (...) {
+      _exit(2);
+    }
+    _exit(1);  // not reached when killed
+  }
+  close(ready[1]);
+  char c = 0;
+  ASSERT_EQ(read(ready[0], &c, 1), 1) << "child did not reach the middle of its import";
+  close(ready[0]);
+  // The half-written scan is on disk, not only in the child's memory.
+  EXPECT_GT(std::filesystem::file_size(path + "-wal"), 500000u);
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_EQ(WTERMSIG(status), SIGKILL);
+
+  Database db = openSailDatabase(path);
+  EXPECT_TRUE(db.integrityCheck().empty());
+  EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 1);
+  EXPECT_EQ(count(db, "SELECT id FROM scans"), first_scan);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM trim_steps"), 1);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM sections"), 3);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM scans WHERE point_count = 200000"), 0);
+  // And the file takes new writes.
+  importScan(db, meta(1, 95.0), &doc);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 2);
+}
+
+TEST(Import, BlockedWriterFailsWithClearMessage) {
+  TempDir dir;
+  const std::string path = dir.file("a.db");
+  Database holder = openSailDatabase(path);
+  Transaction held(holder);
+  OpenOptions o;
+  o.busy_timeout_ms = 200;
+  Database other = openSailDatabase(path, o);
+  const nlohmann::json doc = analysisDoc(8.0);
+  EXPECT_THROW(importScan(other, meta(0, 90), &doc), DatabaseBusy);
+}
+
+}  // namespace
+}  // namespace sailshape
