@@ -9,5 +9,6 @@ void addAnalyzeCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addDesignCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
+void addDbCommand(CLI::App& app);
 
 }  // namespace sailshape::cli

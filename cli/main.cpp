@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   sailshape::cli::addSimulateCommand(app);
   sailshape::cli::addDesignCommand(app);
   sailshape::cli::addCompareCommand(app);
+  sailshape::cli::addDbCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

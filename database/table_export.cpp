@@ -42,10 +42,10 @@ std::string tableToCsv(const Table& table) {
   return out;
 }
 
-nlohmann::json tableToJson(const Table& table) {
-  nlohmann::json rows = nlohmann::json::array();
+nlohmann::ordered_json tableToJson(const Table& table) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
   for (const auto& row : table.rows) {
-    nlohmann::json o = nlohmann::json::object();
+    nlohmann::ordered_json o = nlohmann::ordered_json::object();
     for (size_t c = 0; c < row.size() && c < table.columns.size(); ++c) {
       const Value& v = row[c];
       if (std::holds_alternative<int64_t>(v)) o[table.columns[c]] = std::get<int64_t>(v);

@@ -10,7 +10,7 @@
 namespace sailshape {
 
 std::string tableToCsv(const Table& table);
-nlohmann::json tableToJson(const Table& table);
+nlohmann::ordered_json tableToJson(const Table& table);  // keys in column order
 // Writes by extension or explicit format ("csv" or "json"); throws FileError / InvalidInput.
 void writeTable(const std::string& path, const Table& table, const std::string& format);
 

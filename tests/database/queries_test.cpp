@@ -194,7 +194,7 @@ TEST(TableExport, CsvQuotesAndNulls) {
   t.rows.push_back({int64_t{1}, std::string("plain"), 0.25});
   t.rows.push_back({int64_t{2}, std::string("a,\"b\""), Value{}});
   EXPECT_EQ(tableToCsv(t), "id,name,value\n1,plain,0.25\n2,\"a,\"\"b\"\"\",\n");
-  const nlohmann::json j = tableToJson(t);
+  const nlohmann::ordered_json j = tableToJson(t);
   ASSERT_EQ(j.size(), 2u);
   EXPECT_EQ(j[0]["id"], 1);
   EXPECT_EQ(j[0]["name"], "plain");
