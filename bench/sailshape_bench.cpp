@@ -13,7 +13,13 @@
 #include <pcl/surface/mls.h>
 #include <sys/resource.h>
 
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <memory>
+#include <random>
 #include <map>
 
 #include "analysis/cleaning.hpp"
@@ -24,6 +30,9 @@
 #include "analysis/segmentation.hpp"
 #include "analysis/smoothing.hpp"
 #include "analysis/surface.hpp"
+#include "database/import.hpp"
+#include "database/queries.hpp"
+#include "database/schema.hpp"
 
 namespace {
 
@@ -288,6 +297,106 @@ void BM_Ours_SignedDistance(benchmark::State& state) {
   finish(state, c.size());
 }
 
+
+// ---- the design-flying database: 10,000 scans, 200,000 sections ----
+// 40 sails (10 boats, 4 types, 5 campaigns), 250 scans each in 25 tests of 10
+// trim steps; AWA uniform in 30..170°, forces and two control settings random
+// (seed 11); 20 sections per scan. Built once in a temp file, removed at exit.
+struct BenchDatabase {
+  std::string path = "/tmp/sailshape-bench-" + std::to_string(getpid()) + ".db";
+  std::unique_ptr<Database> db;
+  double build_seconds = 0;
+  BenchDatabase() {
+    const auto start = std::chrono::steady_clock::now();
+    db = std::make_unique<Database>(openSailDatabase(path));
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> awa(30, 170), force(50, 500), control(0, 1), camber(5, 20);
+    const char* types[] = {"mainsail", "genoa", "gennaker", "spinnaker"};
+    nlohmann::json doc;
+    doc["sections"] = nlohmann::json::array();
+    for (int k = 0; k < 20; ++k) doc["sections"].push_back({{"fraction", (k + 1) / 21.0}});
+    for (int scan = 0; scan < 10'000; ++scan) {
+      const int sail = scan / 250, test = (scan % 250) / 10, step = scan % 10;
+      ImportMetadata m;
+      m.campaign = "campaign-" + std::to_string(sail % 5);
+      m.boat = "boat-" + std::to_string(sail % 10);
+      m.sail = "sail-" + std::to_string(sail);
+      m.sail_type = types[sail % 4];
+      m.test = "test-" + std::to_string(test);
+      m.trim_step = step;
+      m.awa_deg = awa(rng);
+      m.drive_n = force(rng);
+      m.side_n = force(rng);
+      m.controls = {{"sheet", control(rng)}, {"tack_height", control(rng)}};
+      for (auto& sec : doc["sections"]) {
+        sec["camber_pct"] = camber(rng);
+        sec["draft_pct"] = 40.0;
+        sec["twist_deg"] = 10.0;
+        sec["uncertainty"] = {{"camber_pct", 0.2}};
+        sec["curve"] = {{0.0, 0.0, 1.0}, {1.0, 0.1, 1.0}, {2.0, 0.0, 1.0}};
+      }
+      importScan(*db, m, &doc);
+    }
+    build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  ~BenchDatabase() {
+    db.reset();
+    for (const char* tail : {"", "-wal", "-shm"}) std::remove((path + tail).c_str());
+  }
+};
+
+BenchDatabase& benchDatabase() {
+  static BenchDatabase b;
+  return b;
+}
+
+template <typename Query>
+void runQuery(benchmark::State& state, Query query) {
+  BenchDatabase& b = benchDatabase();
+  size_t rows = 0;
+  for (auto _ : state) rows = query(*b.db).rows.size();
+  state.counters["rows"] = static_cast<double>(rows);
+  state.counters["build_s"] = b.build_seconds;
+}
+
+void BM_Db_ScansBySailAndAwa(benchmark::State& state) {
+  ScanFilter f;
+  f.sail = "sail-7";
+  f.awa_min_deg = 90;
+  f.awa_max_deg = 100;
+  runQuery(state, [&](Database& db) { return findScans(db, f); });
+}
+void BM_Db_ScansBySailTypeAndControl(benchmark::State& state) {
+  ScanFilter f;
+  f.sail_type = "genoa";
+  f.control = "sheet";
+  f.control_min = 0.4;
+  f.control_max = 0.5;
+  runQuery(state, [&](Database& db) { return findScans(db, f); });
+}
+void BM_Db_ScansByCampaign(benchmark::State& state) {
+  ScanFilter f;
+  f.campaign = "campaign-3";
+  runQuery(state, [&](Database& db) { return findScans(db, f); });
+}
+void BM_Db_SectionsByAwa(benchmark::State& state) {
+  ScanFilter f;
+  f.awa_min_deg = 94;
+  f.awa_max_deg = 96;
+  runQuery(state, [&](Database& db) { return findSections(db, f); });
+}
+void BM_Db_ParameterEvolution(benchmark::State& state) {
+  ScanFilter f;
+  f.sail = "sail-12";
+  runQuery(state, [&](Database& db) { return parameterEvolution(db, "test-3", "camber_pct", 0.5, f); });
+}
+void BM_Db_CompareSails(benchmark::State& state) {
+  runQuery(state, [&](Database& db) { return compareSails(db, "sail-3", "sail-17", 95.0, 5.0); });
+}
+void BM_Db_BestTrimStep(benchmark::State& state) {
+  runQuery(state, [&](Database& db) { return bestTrimSteps(db, 85, 105, TrimCriterion::DriveOverSide, 5); });
+}
+
 #define SIZES Arg(50'000)->Arg(200'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->Iterations(1)
 BENCHMARK(BM_Ours_Normals)->SIZES;
 BENCHMARK(BM_Pcl_Normals)->SIZES;
@@ -302,6 +411,14 @@ BENCHMARK(BM_Pcl_GreedyProjection)->SIZES;
 BENCHMARK(BM_Ours_WholeAnalysis)->SIZES;
 BENCHMARK(BM_Pcl_WholeAnalysis)->SIZES;
 BENCHMARK(BM_Ours_SignedDistance)->SIZES;
+#define QUERY Unit(benchmark::kMillisecond)
+BENCHMARK(BM_Db_ScansBySailAndAwa)->QUERY;
+BENCHMARK(BM_Db_ScansBySailTypeAndControl)->QUERY;
+BENCHMARK(BM_Db_ScansByCampaign)->QUERY;
+BENCHMARK(BM_Db_SectionsByAwa)->QUERY;
+BENCHMARK(BM_Db_ParameterEvolution)->QUERY;
+BENCHMARK(BM_Db_CompareSails)->QUERY;
+BENCHMARK(BM_Db_BestTrimStep)->QUERY;
 
 }  // namespace
 
