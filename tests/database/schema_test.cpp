@@ -142,6 +142,36 @@ TEST(Schema, DamagedDatabaseGivesClearErrorAndIsNotOverwritten) {
   EXPECT_EQ(test::readBytes(path), bytes);
 }
 
+TEST(Schema, DamagedPagesAreReportedAndTheFileIsNotOverwritten) {
+  TempDir dir;
+  const std::string path = dir.file("damaged-pages.db");
+  {
+    Database db = openSailDatabase(path);
+    Transaction tx(db);
+    Statement s = db.prepare("INSERT INTO boats(name, notes) VALUES (?, ?)");
+    for (int i = 0; i < 400; ++i) {
+      s.bind(1, "boat " + std::to_string(i)).bind(2, std::string(200, 'n')).run();
+      s.reset();
+    }
+    tx.commit();
+    db.exec("PRAGMA wal_checkpoint(TRUNCATE)");
+  }
+  std::string bytes = test::readBytes(path);
+  ASSERT_GT(bytes.size(), 20u * 4096);
+  // Garbage over two pages in the middle of the boats table's b-tree.
+  for (size_t i = bytes.size() / 2; i < bytes.size() / 2 + 8192; ++i) bytes[i] = char(0xA5);
+  { std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes; }
+  bool reported = false;
+  try {
+    Database db = openSailDatabase(path);
+    reported = !db.integrityCheck().empty();
+  } catch (const DatabaseError& e) {
+    reported = std::string(e.what()).find("damaged") != std::string::npos;
+  }
+  EXPECT_TRUE(reported);
+  EXPECT_EQ(test::readBytes(path), bytes);
+}
+
 TEST(Schema, MissingFileWithoutCreateThrows) {
   TempDir dir;
   OpenOptions o;

@@ -1,0 +1,132 @@
+// Runs `sailshape db` as a user would: exit codes, one-line errors, files.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string readText(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class DbCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("sailshape-dbcli-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    db_ = (dir_ / "t.db").string();
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Outcome run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string(SAILSHAPE_BIN) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readText(out), readText(err)};
+  }
+
+  std::string analysisJson(double camber) {
+    nlohmann::json doc;
+    doc["sections"] = nlohmann::json::array();
+    for (int k = 0; k < 3; ++k)
+      doc["sections"].push_back({{"fraction", 0.25 * (k + 1)}, {"camber_pct", camber + k}, {"draft_pct", 42.0},
+                                 {"uncertainty", {{"camber_pct", 0.3}}}, {"curve", {{0, 0, 1}, {1, 0.1, 1}}}});
+    const fs::path p = dir_ / ("a" + std::to_string(int(camber)) + ".json");
+    std::ofstream(p) << doc.dump();
+    return p.string();
+  }
+
+  fs::path dir_;
+  std::string db_;
+};
+
+int countLines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+TEST_F(DbCli, InitImportQueryExportCheckBackup) {
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  for (int step = 0; step < 3; ++step) {
+    const Outcome o = run("db import " + db_ + " " + analysisJson(8 + step) + " --campaign Lorient --sail G1 --sail-type genoa" +
+                          " --test sweep --trim-step " + std::to_string(step) + " --awa " + std::to_string(90 + 5 * step) +
+                          " --drive " + std::to_string(100 + 20 * step) + " --side 50 --set sheet=0." + std::to_string(step));
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_NE(o.out.find("3 sections"), std::string::npos) << o.out;
+  }
+  Outcome list = run("db list " + db_ + " --csv");
+  ASSERT_EQ(list.exit_code, 0) << list.err;
+  EXPECT_EQ(countLines(list.out), 4);  // header + 3 scans
+
+  Outcome evo = run("db query " + db_ + " --evolution camber_pct --test sweep --fraction 0.5 --json");
+  ASSERT_EQ(evo.exit_code, 0) << evo.err;
+  const auto j = nlohmann::json::parse(evo.out);
+  ASSERT_EQ(j.size(), 3u);
+  EXPECT_DOUBLE_EQ(j[2]["value"].get<double>(), 11.0);
+
+  Outcome best = run("db query " + db_ + " --best drive --awa-min 85 --awa-max 100 --csv");
+  ASSERT_EQ(best.exit_code, 0) << best.err;
+  EXPECT_NE(best.out.find(",G1,sweep,2,100,140,50,"), std::string::npos) << best.out;
+
+  const std::string csv = (dir_ / "sections.csv").string();
+  ASSERT_EQ(run("db export " + db_ + " " + csv + " --sections --awa-min 94 --awa-max 96").exit_code, 0);
+  EXPECT_EQ(countLines(readText(csv)), 4);  // header + the 3 sections at 95°
+
+  Outcome show = run("db show " + db_ + " 2");
+  ASSERT_EQ(show.exit_code, 0) << show.err;
+  EXPECT_NE(show.out.find("sheet=0.1"), std::string::npos) << show.out;
+  EXPECT_NE(run("db show " + db_ + " 99").exit_code, 0);
+
+  EXPECT_EQ(run("db check " + db_).exit_code, 0);
+  const std::string copy = (dir_ / "copy.db").string();
+  ASSERT_EQ(run("db backup " + db_ + " " + copy).exit_code, 0);
+  EXPECT_EQ(run("db check " + copy).exit_code, 0);
+  EXPECT_EQ(run("db list " + copy + " --csv").out, list.out);
+}
+
+TEST_F(DbCli, ErrorsAreOneLineAndNonZero) {
+  const std::string notes = (dir_ / "notes.db").string();
+  std::ofstream(notes) << "not a database, just a long enough line of text to fill a header\n";
+  const std::string before = readText(notes);
+  for (const std::string& args : {"db check " + notes, "db init " + notes, "db list " + notes,
+                                  "db list " + (dir_ / "missing.db").string()}) {
+    const Outcome o = run(args);
+    EXPECT_NE(o.exit_code, 0) << args;
+    EXPECT_EQ(countLines(o.err), 1) << args << ": " << o.err;
+  }
+  EXPECT_EQ(readText(notes), before);
+  EXPECT_FALSE(fs::exists(dir_ / "missing.db"));
+
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  const Outcome bad_set = run("db import " + db_ + " " + analysisJson(8) + " --set sheet=abc");
+  EXPECT_NE(bad_set.exit_code, 0);
+  EXPECT_NE(bad_set.err.find("--set sheet needs a number"), std::string::npos) << bad_set.err;
+  const Outcome no_format = run("db export " + db_ + " " + (dir_ / "out.txt").string());
+  EXPECT_NE(no_format.exit_code, 0);
+  EXPECT_NE(no_format.err.find("--csv or --json"), std::string::npos) << no_format.err;
+  EXPECT_NE(run("db query " + db_ + " --evolution camber_pct").exit_code, 0);  // needs --test
+}
+
+}  // namespace
