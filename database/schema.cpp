@@ -23,7 +23,7 @@ CREATE TABLE sails (
   name TEXT NOT NULL UNIQUE,
   type TEXT,                -- mainsail, genoa, gennaker, spinnaker, ...
   size_variant TEXT, designer TEXT, version TEXT,
-  design_mesh BLOB,         -- the design surface as a binary PLY
+  design_mesh BLOB,         -- the design surface, database/catalog.hpp packMesh
   design_params TEXT);      -- JSON
 CREATE TABLE scanner_units (
   id INTEGER PRIMARY KEY,

@@ -1,0 +1,148 @@
+#include "database/catalog.hpp"
+
+#include <cstring>
+
+#include "analysis/errors.hpp"
+
+namespace sailshape {
+namespace {
+
+int64_t sailId(Database& db, const std::string& sail, const char* function) {
+  Statement s = db.prepare("SELECT id FROM sails WHERE name = ?");
+  s.bind(1, sail);
+  if (!s.step()) throw InvalidInput(std::string("[") + function + "] no sail named \"" + sail + "\"");
+  return s.columnInt(0);
+}
+
+int64_t unitId(Database& db, const std::string& serial) {
+  db.prepare("INSERT OR IGNORE INTO scanner_units(serial) VALUES (?)").bind(1, serial).run();
+  Statement s = db.prepare("SELECT id FROM scanner_units WHERE serial = ?");
+  s.bind(1, serial).step();
+  return s.columnInt(0);
+}
+
+void setIfGiven(Database& db, const char* column, const std::string& value, int64_t id) {
+  if (!value.empty())
+    db.prepare(std::string("UPDATE sails SET ") + column + " = ? WHERE id = ?").bind(1, value).bind(2, id).run();
+}
+
+}  // namespace
+
+std::vector<uint8_t> packMesh(const Mesh& mesh) {
+  const uint64_t nv = mesh.vertices.size(), nt = mesh.triangles.size();
+  std::vector<uint8_t> out(4 + 16 + nv * 24 + nt * 12);
+  std::memcpy(out.data(), "SSM1", 4);
+  std::memcpy(out.data() + 4, &nv, 8);
+  std::memcpy(out.data() + 12, &nt, 8);
+  uint8_t* p = out.data() + 20;
+  for (const Vec3& v : mesh.vertices) std::memcpy(p, v.data(), 24), p += 24;
+  for (const auto& t : mesh.triangles) std::memcpy(p, t.data(), 12), p += 12;
+  return out;
+}
+
+Mesh unpackMesh(const std::vector<uint8_t>& blob) {
+  uint64_t nv = 0, nt = 0;
+  if (blob.size() < 20 || std::memcmp(blob.data(), "SSM1", 4) != 0)
+    throw DatabaseError("[unpackMesh] not a sailshape mesh blob (" + std::to_string(blob.size()) + " bytes)");
+  std::memcpy(&nv, blob.data() + 4, 8);
+  std::memcpy(&nt, blob.data() + 12, 8);
+  if (nv > blob.size() || nt > blob.size() || blob.size() != 20 + nv * 24 + nt * 12)
+    throw DatabaseError("[unpackMesh] " + std::to_string(nv) + " vertices and " + std::to_string(nt) +
+                        " triangles do not fit " + std::to_string(blob.size()) + " bytes");
+  Mesh mesh;
+  mesh.vertices.resize(nv);
+  mesh.triangles.resize(nt);
+  const uint8_t* p = blob.data() + 20;
+  for (auto& v : mesh.vertices) std::memcpy(v.data(), p, 24), p += 24;
+  for (auto& t : mesh.triangles) {
+    std::memcpy(t.data(), p, 12), p += 12;
+    for (uint32_t i : t)
+      if (i >= nv) throw DatabaseError("[unpackMesh] triangle index " + std::to_string(i) + " >= " + std::to_string(nv));
+  }
+  return mesh;
+}
+
+int64_t upsertSail(Database& db, const SailInfo& info, const Mesh* design_mesh, const nlohmann::json* design_params) {
+  if (info.name.empty()) throw InvalidInput("[upsertSail] sail name must not be empty");
+  Transaction tx(db);
+  db.prepare("INSERT OR IGNORE INTO sails(name) VALUES (?)").bind(1, info.name).run();
+  const int64_t id = sailId(db, info.name, "upsertSail");
+  setIfGiven(db, "type", info.type, id);
+  setIfGiven(db, "size_variant", info.size_variant, id);
+  setIfGiven(db, "designer", info.designer, id);
+  setIfGiven(db, "version", info.version, id);
+  if (!info.boat.empty()) {
+    db.prepare("INSERT OR IGNORE INTO boats(name) VALUES (?)").bind(1, info.boat).run();
+    db.prepare("UPDATE sails SET boat_id = (SELECT id FROM boats WHERE name = ?) WHERE id = ?").bind(1, info.boat).bind(2, id).run();
+  }
+  if (design_mesh) db.prepare("UPDATE sails SET design_mesh = ? WHERE id = ?").bindBlob(1, packMesh(*design_mesh)).bind(2, id).run();
+  if (design_params) db.prepare("UPDATE sails SET design_params = ? WHERE id = ?").bind(1, design_params->dump()).bind(2, id).run();
+  tx.commit();
+  return id;
+}
+
+Mesh sailDesignMesh(Database& db, const std::string& sail) {
+  Statement s = db.prepare("SELECT design_mesh FROM sails WHERE name = ?");
+  s.bind(1, sail);
+  if (!s.step()) throw InvalidInput("[sailDesignMesh] no sail named \"" + sail + "\"");
+  if (s.isNull(0)) throw InvalidInput("[sailDesignMesh] sail \"" + sail + "\" has no design mesh");
+  return unpackMesh(s.columnBlob(0));
+}
+
+int64_t addCalibration(Database& db, const std::string& serial, const Calibration& c) {
+  if (serial.empty()) throw InvalidInput("[addCalibration] scanner serial must not be empty");
+  if (c.calibrated_at.empty()) throw InvalidInput("[addCalibration] calibrated_at must not be empty");
+  Transaction tx(db);
+  const int64_t unit = unitId(db, serial);
+  db.prepare("INSERT INTO calibrations(unit_id, calibrated_at, p_m, theta_deg) VALUES (?, ?, ?, ?)")
+      .bind(1, unit).bind(2, c.calibrated_at).bind(3, c.p_m).bind(4, c.theta_deg).run();
+  const int64_t id = db.lastInsertId();
+  tx.commit();
+  return id;
+}
+
+std::optional<Calibration> calibrationAt(Database& db, const std::string& serial, const std::string& at) {
+  Statement s = db.prepare(
+      "SELECT k.calibrated_at, k.p_m, k.theta_deg FROM calibrations k JOIN scanner_units u ON u.id = k.unit_id"
+      " WHERE u.serial = ? AND k.calibrated_at <= ? ORDER BY k.calibrated_at DESC, k.id DESC LIMIT 1");
+  s.bind(1, serial).bind(2, at);
+  if (!s.step()) return std::nullopt;
+  return Calibration{s.columnText(0), s.columnDouble(1), s.columnDouble(2)};
+}
+
+int64_t addRegistration(Database& db, int64_t scan_id, const Eigen::Matrix4d& transform, double fitness, double rmse_m) {
+  if (!transform.allFinite()) throw InvalidInput("[addRegistration] transform has non-finite entries");
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({transform(r, 0), transform(r, 1), transform(r, 2), transform(r, 3)});
+  Statement s = db.prepare("INSERT INTO registrations(scan_id, transform, fitness, rmse_m) VALUES (?, ?, ?, ?)");
+  s.bind(1, scan_id).bind(2, rows.dump()).bind(3, fitness).bind(4, rmse_m).run();  // foreign key checks scan_id
+  return db.lastInsertId();
+}
+
+Eigen::Matrix4d scanTransform(Database& db, int64_t scan_id) {
+  Statement s = db.prepare("SELECT transform FROM registrations WHERE scan_id = ? ORDER BY id DESC LIMIT 1");
+  s.bind(1, scan_id);
+  if (!s.step()) throw InvalidInput("[scanTransform] scan " + std::to_string(scan_id) + " has no registration");
+  const nlohmann::json rows = nlohmann::json::parse(s.columnText(0));
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = rows.at(r).at(c).get<double>();
+  return m;
+}
+
+int64_t addDesignComparison(Database& db, int64_t analysis_id, const std::string& sail, const DistanceStats& stats,
+                            const nlohmann::json& details) {
+  const int64_t sail_id = sailId(db, sail, "addDesignComparison");
+  nlohmann::json all = details;
+  all["count"] = stats.count;
+  all["p5_m"] = stats.p5_m;
+  all["p50_m"] = stats.p50_m;
+  all["p95_m"] = stats.p95_m;
+  Statement s = db.prepare(
+      "INSERT INTO design_comparisons(analysis_id, sail_id, mean_m, rms_m, max_abs_m, stats) VALUES (?, ?, ?, ?, ?, ?)");
+  s.bind(1, analysis_id).bind(2, sail_id).bind(3, stats.mean_m).bind(4, stats.rms_m).bind(5, stats.max_abs_m);
+  s.bind(6, all.dump()).run();
+  return db.lastInsertId();
+}
+
+}  // namespace sailshape

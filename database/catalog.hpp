@@ -1,0 +1,54 @@
+#pragma once
+// What surrounds the scans: sails with their design, scanner units with their
+// calibration history, registrations and design-vs-flying statistics.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "analysis/design_compare.hpp"
+#include "analysis/mesh.hpp"
+#include "database/sqlite.hpp"
+
+namespace sailshape {
+
+struct SailInfo {
+  std::string name;
+  std::string type, size_variant, designer, version;  // empty: left as stored
+  std::string boat;                                   // empty: left as stored; created when new
+};
+
+// Creates or updates the sail `info.name`; stores the design mesh and design
+// parameters when given. Returns the sail's id. One transaction.
+int64_t upsertSail(Database& db, const SailInfo& info, const Mesh* design_mesh = nullptr,
+                   const nlohmann::json* design_params = nullptr);
+
+// The stored design mesh of `sail`; throws InvalidInput when the sail or its design is missing.
+Mesh sailDesignMesh(Database& db, const std::string& sail);
+
+// Mesh blob: "SSM1", uint64 vertex count, uint64 triangle count, float64 xyz (metres), uint32 indices.
+std::vector<uint8_t> packMesh(const Mesh& mesh);
+Mesh unpackMesh(const std::vector<uint8_t>& blob);
+
+struct Calibration {
+  std::string calibrated_at;  // ISO 8601
+  double p_m = 0;             // SPEC §2 mirror-to-axis offset
+  double theta_deg = 0;       // SPEC §2 scan plane tilt
+};
+
+// Adds a calibration of scanner `serial` (the unit is created when new).
+int64_t addCalibration(Database& db, const std::string& serial, const Calibration& calibration);
+// The unit's calibration in force at `at` (the latest not after it), if any.
+std::optional<Calibration> calibrationAt(Database& db, const std::string& serial, const std::string& at);
+
+// Scanner-to-boat transform of a scan (row-major JSON in the file).
+int64_t addRegistration(Database& db, int64_t scan_id, const Eigen::Matrix4d& transform, double fitness, double rmse_m);
+Eigen::Matrix4d scanTransform(Database& db, int64_t scan_id);  // the latest; throws InvalidInput when none
+
+// Design-vs-flying statistics of an analysis against its sail's design.
+int64_t addDesignComparison(Database& db, int64_t analysis_id, const std::string& sail, const DistanceStats& stats,
+                            const nlohmann::json& details = nlohmann::json::object());
+
+}  // namespace sailshape
