@@ -108,4 +108,28 @@ double medianSpacing(const NeighbourTable& table) {
   return std::sqrt(static_cast<double>(d[d.size() / 2]));
 }
 
+double medianNeighbourDistance(const KdTree& tree, const std::vector<Vec3>& points, size_t k, size_t samples) {
+  if (points.size() < 2 || k < 2) return 0.0;
+  std::vector<double> d;
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  const size_t step = std::max<size_t>(1, points.size() / std::max<size_t>(1, samples));
+  for (size_t i = 0; i < points.size(); i += step) {
+    tree.nearest(points[i], k, idx, d2);
+    d.push_back(std::sqrt(d2.back()));
+  }
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+Eigen::Vector3i voxelOf(const Vec3& p, double size) {
+  return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / size)), static_cast<int>(std::floor(p.y() / size)),
+                         static_cast<int>(std::floor(p.z() / size)));
+}
+
+int64_t voxelKey(const Eigen::Vector3i& c) {
+  return (static_cast<int64_t>(c.x()) * 73856093) ^ (static_cast<int64_t>(c.y()) * 19349663) ^
+         (static_cast<int64_t>(c.z()) * 83492791);
+}
+
 }  // namespace sailshape

@@ -47,4 +47,13 @@ NeighbourTable nearestNeighbours(const std::vector<Vec3>& points, size_t k, cons
 // Median distance from each point to its nearest other point, m (0 for < 2 points).
 double medianSpacing(const NeighbourTable& table);
 
+// Median distance to the k-th nearest point (the point itself counts as the
+// first), over about `samples` points spread through `points`, m.
+double medianNeighbourDistance(const KdTree& tree, const std::vector<Vec3>& points, size_t k, size_t samples = 512);
+
+// Integer cell of a uniform grid of cubes `size` metres wide, and a hash of it.
+Eigen::Vector3i voxelOf(const Vec3& p, double size);
+int64_t voxelKey(const Eigen::Vector3i& cell);
+inline int64_t voxelKey(const Vec3& p, double size) { return voxelKey(voxelOf(p, size)); }
+
 }  // namespace sailshape

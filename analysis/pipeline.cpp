@@ -46,10 +46,7 @@ VoxelSample voxelSample(const Cloud& in, double voxel) {
   std::vector<uint32_t> count;
   for (size_t i = 0; i < in.size(); ++i) {
     const Vec3& p = in.points[i];
-    const int64_t key = (static_cast<int64_t>(std::floor(p.x() / voxel)) * 73856093) ^
-                        (static_cast<int64_t>(std::floor(p.y() / voxel)) * 19349663) ^
-                        (static_cast<int64_t>(std::floor(p.z() / voxel)) * 83492791);
-    auto [it, fresh] = index.emplace(key, static_cast<uint32_t>(sum.size()));
+    auto [it, fresh] = index.emplace(voxelKey(p, voxel), static_cast<uint32_t>(sum.size()));
     if (fresh) {
       sum.push_back(Vec3::Zero());
       count.push_back(0);
@@ -61,22 +58,6 @@ VoxelSample voxelSample(const Cloud& in, double voxel) {
   out.cloud.points.resize(sum.size());
   for (size_t v = 0; v < sum.size(); ++v) out.cloud.points[v] = sum[v] / static_cast<double>(count[v]);
   return out;
-}
-
-// Median nearest-neighbour distance over a sample of up to 512 points, m.
-double medianSpacingEstimate(const std::vector<Vec3>& pts) {
-  if (pts.size() < 2) return 0;
-  KdTree tree(pts);
-  std::vector<double> d;
-  std::vector<uint32_t> idx;
-  std::vector<double> d2;
-  const size_t step = std::max<size_t>(1, pts.size() / 512);
-  for (size_t i = 0; i < pts.size(); i += step) {
-    tree.nearest(pts[i], 2, idx, d2);
-    d.push_back(std::sqrt(d2.back()));
-  }
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
 }
 
 }  // namespace
@@ -97,7 +78,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     // Work on a voxel-grid sample when the scan is denser than the voxel.
     const double voxel = p.segmentation_voxel_sigmas * p.sensor_sigma_m;
     VoxelSample sample;
-    const bool thin = voxel > 0 && medianSpacingEstimate(cloud.points) < 0.8 * voxel;
+    const bool thin = voxel > 0 && medianNeighbourDistance(KdTree(cloud.points), cloud.points, 2) < 0.8 * voxel;
     if (thin) sample = voxelSample(cloud, voxel);
     const Cloud& seg_cloud = thin ? sample.cloud : cloud;
     const size_t k = static_cast<size_t>(std::max(p.normals.k_neighbours, p.region_growing.k_neighbours));

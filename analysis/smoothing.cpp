@@ -82,11 +82,7 @@ std::vector<uint32_t> pickAnchors(const std::vector<Vec3>& pts, double cell) {
     uint32_t count = 0, best = 0;
     double best_d2 = 0;
   };
-  auto key = [cell](const Vec3& p) {
-    const int64_t x = static_cast<int64_t>(std::floor(p.x() / cell)), y = static_cast<int64_t>(std::floor(p.y() / cell)),
-                  z = static_cast<int64_t>(std::floor(p.z() / cell));
-    return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
-  };
+  auto key = [cell](const Vec3& p) { return voxelKey(p, cell); };
   std::unordered_map<int64_t, Acc> cells;
   cells.reserve(pts.size() / 4 + 1);
   for (const Vec3& p : pts) {
@@ -135,16 +131,7 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
   KdTree tree(pts);
   {
     // The neighbourhood radius, from a sample of points.
-    std::vector<double> radii;
-    std::vector<uint32_t> idx;
-    std::vector<double> d2;
-    const size_t step = std::max<size_t>(1, cloud.size() / 256);
-    for (size_t i = 0; i < cloud.size(); i += step) {
-      tree.nearest(pts[i], k, idx, d2);
-      radii.push_back(std::sqrt(d2.back()));
-    }
-    std::nth_element(radii.begin(), radii.begin() + radii.size() / 2, radii.end());
-    const double radius = radii[radii.size() / 2];
+    const double radius = medianNeighbourDistance(tree, pts, k, 256);
     std::vector<uint32_t> anchors;
     if (p.anchor_ratio > 0) {
       anchors = pickAnchors(pts, std::max(1e-6, p.anchor_ratio * radius));
@@ -157,17 +144,9 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
     // Neighbourhoods by a uniform grid of cells one radius wide: every point
     // within the radius lies in the 27 cells around the anchor's.
     const double cell = radius;
-    auto cellOf = [cell](const Vec3& q) {
-      return Eigen::Vector3i(static_cast<int>(std::floor(q.x() / cell)), static_cast<int>(std::floor(q.y() / cell)),
-                             static_cast<int>(std::floor(q.z() / cell)));
-    };
-    auto cellKey = [](const Eigen::Vector3i& c) {
-      return (static_cast<int64_t>(c.x()) * 73856093) ^ (static_cast<int64_t>(c.y()) * 19349663) ^
-             (static_cast<int64_t>(c.z()) * 83492791);
-    };
     std::unordered_map<int64_t, std::vector<uint32_t>> grid;
     grid.reserve(pts.size() / 64 + 1);
-    for (uint32_t i = 0; i < pts.size(); ++i) grid[cellKey(cellOf(pts[i]))].push_back(i);
+    for (uint32_t i = 0; i < pts.size(); ++i) grid[voxelKey(pts[i], cell)].push_back(i);
     const double r2 = radius * radius;
     double radius_sum = 0;
     size_t too_few = 0;
@@ -179,13 +158,13 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
 #pragma omp for schedule(dynamic, 64)
       for (long a = 0; a < na; ++a) {
         const Vec3& at = pts[anchors[static_cast<size_t>(a)]];
-        const Eigen::Vector3i c = cellOf(at);
+        const Eigen::Vector3i c = voxelOf(at, cell);
         row.clear();
         rd2.clear();
         for (int dx = -1; dx <= 1; ++dx)
           for (int dy = -1; dy <= 1; ++dy)
             for (int dz = -1; dz <= 1; ++dz) {
-              auto it = grid.find(cellKey(c + Eigen::Vector3i(dx, dy, dz)));
+              auto it = grid.find(voxelKey(c + Eigen::Vector3i(dx, dy, dz)));
               if (it == grid.end()) continue;
               for (uint32_t j : it->second) {
                 const double d2 = (pts[j] - at).squaredNorm();

@@ -70,6 +70,35 @@ void finish(benchmark::State& state, size_t points) {
   state.counters["peak_MiB"] = peakMemoryMiB();
 }
 
+// PCL's stock normals and region growing, configured like our defaults.
+pcl::PointCloud<pcl::Normal>::Ptr pclNormals(const pcl::PointCloud<pcl::PointXYZ>::Ptr& pc,
+                                             const pcl::search::KdTree<pcl::PointXYZ>::Ptr& tree, int k) {
+  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+  ne.setInputCloud(pc);
+  ne.setSearchMethod(tree);
+  ne.setKSearch(k);
+  auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
+  ne.compute(*normals);
+  return normals;
+}
+
+std::vector<pcl::PointIndices> pclRegionGrowing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& pc,
+                                                const pcl::search::KdTree<pcl::PointXYZ>::Ptr& tree,
+                                                const AnalysisParams& p) {
+  const auto normals = pclNormals(pc, tree, p.normals.k_neighbours);
+  pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
+  rg.setInputCloud(pc);
+  rg.setInputNormals(normals);
+  rg.setSearchMethod(tree);
+  rg.setNumberOfNeighbours(p.region_growing.k_neighbours);
+  rg.setSmoothnessThreshold(static_cast<float>(p.region_growing.max_normal_angle_deg / 180.0 * M_PI));
+  rg.setCurvatureThreshold(static_cast<float>(p.region_growing.max_curvature));
+  rg.setMinClusterSize(static_cast<pcl::uindex_t>(p.region_growing.min_points));
+  std::vector<pcl::PointIndices> clusters;
+  rg.extract(clusters);
+  return clusters;
+}
+
 // ---- normals ----
 void BM_Ours_Normals(benchmark::State& state) {
   const Cloud& c = sail(static_cast<size_t>(state.range(0)));
@@ -78,15 +107,9 @@ void BM_Ours_Normals(benchmark::State& state) {
 }
 void BM_Pcl_Normals(benchmark::State& state) {
   const auto pc = toPcl(sail(static_cast<size_t>(state.range(0))));
-  for (auto _ : state) {
-    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-    ne.setInputCloud(pc);
-    ne.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
-    ne.setKSearch(NormalParams{}.k_neighbours);
-    pcl::PointCloud<pcl::Normal> normals;
-    ne.compute(normals);
-    benchmark::DoNotOptimize(normals.size());
-  }
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        pclNormals(pc, pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>(), NormalParams{}.k_neighbours)->size());
   finish(state, pc->size());
 }
 
@@ -103,27 +126,9 @@ void BM_Ours_RegionGrowing(benchmark::State& state) {
 }
 void BM_Pcl_RegionGrowing(benchmark::State& state) {
   const auto pc = toPcl(sail(static_cast<size_t>(state.range(0))));
-  const AnalysisParams p;
-  for (auto _ : state) {
-    auto tree = pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
-    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-    ne.setInputCloud(pc);
-    ne.setSearchMethod(tree);
-    ne.setKSearch(p.normals.k_neighbours);
-    auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
-    ne.compute(*normals);
-    pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
-    rg.setInputCloud(pc);
-    rg.setInputNormals(normals);
-    rg.setSearchMethod(tree);
-    rg.setNumberOfNeighbours(p.region_growing.k_neighbours);
-    rg.setSmoothnessThreshold(static_cast<float>(p.region_growing.max_normal_angle_deg / 180.0 * M_PI));
-    rg.setCurvatureThreshold(static_cast<float>(p.region_growing.max_curvature));
-    rg.setMinClusterSize(static_cast<pcl::uindex_t>(p.region_growing.min_points));
-    std::vector<pcl::PointIndices> clusters;
-    rg.extract(clusters);
-    benchmark::DoNotOptimize(clusters.size());
-  }
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        pclRegionGrowing(pc, pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>(), AnalysisParams{}).size());
   finish(state, pc->size());
 }
 
@@ -183,15 +188,9 @@ void BM_Pcl_GreedyProjection(benchmark::State& state) {
   const Cloud& c = sail(static_cast<size_t>(state.range(0)));
   const auto pc = toPcl(c);
   for (auto _ : state) {
-    auto tree = pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
-    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-    ne.setInputCloud(pc);
-    ne.setSearchMethod(tree);
-    ne.setKSearch(20);
-    pcl::PointCloud<pcl::Normal> normals;
-    ne.compute(normals);
+    const auto normals = pclNormals(pc, pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>(), 20);
     auto with_normals = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>>();
-    pcl::concatenateFields(*pc, normals, *with_normals);
+    pcl::concatenateFields(*pc, *normals, *with_normals);
     pcl::GreedyProjectionTriangulation<pcl::PointNormal> gp3;
     const double spacing = std::sqrt(18.0 / static_cast<double>(c.size()));
     gp3.setSearchRadius(5 * spacing);
@@ -232,26 +231,10 @@ void BM_Ours_WholeAnalysis(benchmark::State& state) {
 void BM_Pcl_WholeAnalysis(benchmark::State& state) {
   const size_t n = static_cast<size_t>(state.range(0));
   for (auto _ : state) {
-    benchmark::State* s = &state;
-    (void)s;
     const auto pc = toPcl(sail(n));
     const AnalysisParams p;
-    auto tree = pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
-    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-    ne.setInputCloud(pc);
-    ne.setSearchMethod(tree);
-    ne.setKSearch(p.normals.k_neighbours);
-    auto normals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
-    ne.compute(*normals);
-    pcl::RegionGrowing<pcl::PointXYZ, pcl::Normal> rg;
-    rg.setInputCloud(pc);
-    rg.setInputNormals(normals);
-    rg.setSearchMethod(tree);
-    rg.setNumberOfNeighbours(p.region_growing.k_neighbours);
-    rg.setSmoothnessThreshold(static_cast<float>(p.region_growing.max_normal_angle_deg / 180.0 * M_PI));
-    rg.setCurvatureThreshold(static_cast<float>(p.region_growing.max_curvature));
-    std::vector<pcl::PointIndices> clusters;
-    rg.extract(clusters);
+    const std::vector<pcl::PointIndices> clusters =
+        pclRegionGrowing(pc, pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>(), p);
     auto sail_pts = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     size_t best = 0;
     for (size_t i = 1; i < clusters.size(); ++i)

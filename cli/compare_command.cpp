@@ -16,6 +16,7 @@
 #include "analysis/params_io.hpp"
 #include "analysis/pipeline.hpp"
 #include "cli/commands.hpp"
+#include "cli/json_file.hpp"
 #include "cli/progress_bar.hpp"
 
 namespace sailshape::cli {
@@ -149,10 +150,7 @@ void run(const CompareOptions& o) {
                                {"flying", sectionParametersToJson(d.flying)},
                                {"delta", sectionParametersToJson(d.delta)}});
   doc["warnings"] = c.warnings;
-  std::ofstream out(o.json_out);
-  if (!out) throw FileError(o.json_out + ": cannot open for writing");
-  out << doc.dump(2) << "\n";
-  if (!out) throw FileError(o.json_out + ": write failed");
+  writeJsonFile(o.json_out, doc);
   if (!o.quiet) std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());
 }
 

@@ -12,6 +12,7 @@
 #include "analysis/mesh_io.hpp"
 #include "analysis/sail_generator.hpp"
 #include "cli/commands.hpp"
+#include "cli/json_file.hpp"
 
 namespace sailshape::cli {
 namespace {
@@ -31,13 +32,6 @@ struct ShowOptions {
   std::string input, unit = "auto", axes = "auto", json_out;
   int sections = 3, corners = 0;
 };
-
-void writeJson(const std::string& path, const nlohmann::json& doc) {
-  std::ofstream out(path);
-  if (!out) throw FileError(path + ": cannot open for writing");
-  out << doc.dump(2) << "\n";
-  if (!out) throw FileError(path + ": write failed");
-}
 
 // Sets stations[k].*field from values (one per foot/mid/head station).
 template <class Field>
@@ -130,7 +124,7 @@ void runShow(const ShowOptions& o) {
     }
     doc["warnings"] = ol.warnings;
     for (const auto& w : a.sections.warnings) doc["warnings"].push_back(w);
-    writeJson(o.json_out, doc);
+    writeJsonFile(o.json_out, doc);
     std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());
     return;
   }

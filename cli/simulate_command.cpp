@@ -9,6 +9,7 @@
 #include "analysis/sail_generator.hpp"
 #include "analysis/sections.hpp"
 #include "cli/commands.hpp"
+#include "cli/json_file.hpp"
 
 namespace sailshape::cli {
 namespace {
@@ -54,9 +55,7 @@ void run(const SimulateOptions& o) {
                                {"entry_deg", k.entry_deg},
                                {"exit_deg", k.exit_deg}});
   }
-  std::ofstream out(o.truth);
-  if (!out) throw FileError(o.truth + ": cannot open for writing");
-  out << doc.dump(2) << "\n";
+  writeJsonFile(o.truth, doc);
 }
 
 }  // namespace
