@@ -154,6 +154,8 @@ Database openSailDatabase(const std::string& path, const OpenOptions& options) {
       throw DatabaseError("[openSailDatabase] " + path +
                           ": an SQLite database of another application (tables but no sailshape schema); left untouched");
   }
+  // WAL: readers (the viewer) keep reading while a scan is written.
+  if (!options.read_only) db.exec("PRAGMA journal_mode=WAL");
   if (version < kSchemaVersion) {
     if (options.read_only)
       throw DatabaseError("[openSailDatabase] " + path + ": schema version " + std::to_string(version) +

@@ -47,7 +47,6 @@ Database::Database(const std::string& path, const OpenOptions& options)
     // A read first: SQLite opens files lazily, and a foreign file must be
     // refused before any pragma could write to it.
     exec("SELECT count(*) FROM sqlite_schema");
-    if (!options.read_only) exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA foreign_keys=ON");
     exec("PRAGMA synchronous=NORMAL");  // durable with WAL up to the last checkpointed commit; never corrupt
   } catch (...) {

@@ -34,8 +34,9 @@ class Statement;
 class Database {
  public:
   // Opens (or creates) `path`, checks that it is an SQLite database before
-  // anything is written, then sets WAL, foreign_keys=ON and the busy timeout.
-  // Does not touch the schema: see openSailDatabase() in database/schema.hpp.
+  // anything is written, then sets foreign_keys=ON and the busy timeout.
+  // Writes nothing: WAL mode and the schema are openSailDatabase()'s
+  // (database/schema.hpp), once the file is known to be ours.
   explicit Database(const std::string& path, const OpenOptions& options = {});
   ~Database();
   Database(Database&& other) noexcept;

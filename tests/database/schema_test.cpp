@@ -121,7 +121,10 @@ TEST(Schema, ForeignSqliteDatabaseIsRefused) {
     Database db(path);
     db.exec("CREATE TABLE photos(id INTEGER PRIMARY KEY)");
   }
+  const std::string before = test::readBytes(path);
   EXPECT_THROW(openSailDatabase(path), DatabaseError);
+  EXPECT_EQ(test::readBytes(path), before);  // not even switched to WAL
+  EXPECT_FALSE(std::filesystem::exists(path + "-wal"));
   Database db(path);
   EXPECT_EQ(db.userVersion(), 0);
 }
