@@ -88,8 +88,42 @@ NormalEstimation estimateNormals(const Cloud& cloud, const NeighbourTable& table
     eig.computeDirect(cov);
     const Vec3 ev = eig.eigenvalues().cwiseMax(0.0);
     const double sum = ev.sum();
-    result.normals.normals[i] = eig.eigenvectors().col(0).normalized();
+    Vec3 normal = eig.eigenvectors().col(0).normalized();
     result.normals.curvature[i] = sum > 0 ? ev[0] / sum : 0.0;
+    if (params.robust) {
+      // Refit with the neighbours far off the current plane down-weighted
+      // (Cauchy weights on 2.5 robust σ), until the normal settles: a sail point
+      // beside a mast keeps the sail's normal instead of one tilted towards the mast.
+      const size_t kk = std::min<size_t>(k, 512);
+      double r[512], sorted[512], w[512];
+      Vec3 centre = mean;
+      for (int it = 0; it < 4; ++it) {
+        for (size_t j = 0; j < kk; ++j) sorted[j] = r[j] = std::abs((cloud.points[row[j]] - centre).dot(normal));
+        std::nth_element(sorted, sorted + kk / 2, sorted + kk);
+        const double scale = 2.5 * 1.4826 * sorted[kk / 2] + 1e-9;
+        double wsum = 0;
+        Vec3 wmean = Vec3::Zero();
+        for (size_t j = 0; j < kk; ++j) {
+          const double t = r[j] / scale;
+          w[j] = 1.0 / (1.0 + t * t);
+          wsum += w[j];
+          wmean += w[j] * cloud.points[row[j]];
+        }
+        wmean /= wsum;
+        Eigen::Matrix3d wcov = Eigen::Matrix3d::Zero();
+        for (size_t j = 0; j < kk; ++j) {
+          const Vec3 d = cloud.points[row[j]] - wmean;
+          wcov.noalias() += w[j] * d * d.transpose();
+        }
+        eig.computeDirect(wcov);
+        const Vec3 next = eig.eigenvectors().col(0).normalized();
+        const bool settled = std::abs(next.dot(normal)) > std::cos(0.5 * 3.14159265358979 / 180.0);
+        normal = next;
+        centre = wmean;
+        if (settled) break;
+      }
+    }
+    result.normals.normals[i] = normal;
   }
   progress("normals", 1.0);
 

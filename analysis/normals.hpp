@@ -17,6 +17,9 @@ struct NormalParams {
   // the cloud has none); "propagate": consistent across each connected patch by
   // walking the neighbour graph; "none": as computed.
   std::string orientation = "viewpoint";
+  // Refit each normal with neighbours far off the first plane down-weighted
+  // (the curvature stays the plain one).
+  bool robust = true;
 };
 
 struct NormalEstimation {

@@ -261,6 +261,39 @@ TEST(EstimateNormals, WithoutAViewpointFallsBackToPropagationOnASail) {
   EXPECT_TRUE(agree == 0 || agree == sail.size()) << agree << " of " << sail.size() << " agree with the viewpoint";
 }
 
+TEST(EstimateNormals, RobustRefitKeepsAPlaneNormalBesideAPerpendicularWall) {
+  // A floor (z = 0, 1 cm grid, 1 mm noise) meeting a wall (x = 0.2): floor points
+  // 2–4 cm from the wall have up to about a third of their 30 neighbours on it,
+  // and the plain fit tilts their normals by more than 10°. The down-weighted
+  // refit removes a good part of that tilt (measured: 13° → 9° at the worst
+  // point). It does not reach the noise level (< 1°): starting from the tilted
+  // plane, the reweighting settles on a compromise; a better start is future work.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  Cloud c;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j < 40; ++j) c.points.emplace_back(0.01 * i, 0.01 * j, noise(rng));
+  const size_t floor_points = c.points.size();
+  for (int i = 1; i <= 20; ++i)
+    for (int j = 0; j < 40; ++j) c.points.emplace_back(0.2 + noise(rng), 0.01 * j, 0.01 * i);
+  c.viewpoint = Vec3(-1, 0.2, 1);
+  NormalParams plain;
+  plain.k_neighbours = 30;
+  plain.robust = false;
+  NormalParams robust = plain;
+  robust.robust = true;
+  const Normals a = estimateNormals(c, plain).normals, b = estimateNormals(c, robust).normals;
+  double worst_plain = 0, worst_robust = 0;
+  for (size_t i = 0; i < floor_points; ++i) {
+    const Vec3& p = c.points[i];
+    if (p.x() < 0.155 || p.x() > 0.185 || p.y() < 0.05 || p.y() > 0.34) continue;  // 2–4 cm from the wall
+    worst_plain = std::max(worst_plain, std::acos(std::min(1.0, std::abs(a.normals[i].z()))) * 180.0 / M_PI);
+    worst_robust = std::max(worst_robust, std::acos(std::min(1.0, std::abs(b.normals[i].z()))) * 180.0 / M_PI);
+  }
+  EXPECT_GT(worst_plain, 10.0);
+  EXPECT_LT(worst_robust, 0.8 * worst_plain);
+}
+
 TEST(EstimateNormals, ReusingANeighbourTableGivesTheSameResult) {
   const Plane plane = noisyPlane(3000, 1.0, kSigma, 8);
   NormalParams p;
