@@ -431,7 +431,7 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
       std::vector<Eigen::Vector2d> win;
       const double x_end = at_luff ? 0.0 : f.chord;
       for (const auto& v : xy)
-        if (std::abs(v.x() - x_end) <= p.end_window * f.chord && std::abs(v.x() - x_end) >= (getenv("ESKIP") ? atof(getenv("ESKIP")) : 0.0) * spacing) win.emplace_back(v.x(), side * v.y());
+        if (std::abs(v.x() - x_end) <= p.end_window * f.chord) win.emplace_back(v.x(), side * v.y());
       const QuadFit q = fitQuadratic(win, x_end, 0.0);
       if (!q.ok) {
         sd_deg = std::numeric_limits<double>::quiet_NaN();
