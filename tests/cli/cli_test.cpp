@@ -13,23 +13,15 @@
 #include <vector>
 
 #include "analysis/params_io.hpp"
+#include "tests/cli/run_sailshape.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string readText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using sailshape::testing::Outcome;
+using sailshape::testing::readText;
 
 std::vector<std::string> lines(const std::string& text) {
   std::vector<std::string> result;
@@ -49,18 +41,7 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  // `args` are appended to the command line as they are (paths here have no spaces).
-  Outcome sailshape(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd =
-        std::string("'") + SAILSHAPE_BIN + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "' </dev/null";
-    const int status = std::system(cmd.c_str());
-    Outcome r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = readText(out);
-    r.err = readText(err);
-    return r;
-  }
+  Outcome sailshape(const std::string& args) { return sailshape::testing::runSailshape(dir_, args); }
 
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   fs::path dir_;

@@ -12,21 +12,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/cli/run_sailshape.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string readText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using sailshape::testing::Outcome;
+using sailshape::testing::readText;
 
 class DbCli : public ::testing::Test {
  protected:
@@ -39,12 +32,7 @@ class DbCli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Outcome run(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(SAILSHAPE_BIN) + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readText(out), readText(err)};
-  }
+  Outcome run(const std::string& args) { return sailshape::testing::runSailshape(dir_, args); }
 
   std::string analysisJson(double camber) {
     nlohmann::json doc;
