@@ -131,7 +131,7 @@ struct ColaStreamStats {
   uint64_t bad_checksum = 0;       // CoLa B frames whose XOR did not match: dropped
   uint64_t bad_length = 0;         // CoLa B length 0 or over max_payload_bytes: start marker skipped
   uint64_t unterminated = 0;       // CoLa A frames cut by a new STX or longer than the limit: dropped
-  uint64_t garbage_bytes = 0;      // bytes skipped while looking for a start marker
+  uint64_t garbage_bytes = 0;      // bytes skipped while looking for a start marker (incl. a dropped frame's)
 };
 
 // Turns a byte stream cut anywhere into payloads.
