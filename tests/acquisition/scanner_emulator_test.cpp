@@ -1,0 +1,294 @@
+// The scanner emulator through a real TCP socket: SICK's recorded driver
+// command sequence gets replies of the recorded types, and the stream carries
+// the point count the output range implies, ranges from the scene.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <map>
+#include <thread>
+
+#include "acquisition/capture.hpp"
+#include "acquisition/cola.hpp"
+#include "acquisition/scan_data.hpp"
+#include "acquisition/scanner_emulator.hpp"
+#include "analysis/errors.hpp"
+
+using namespace sailshape;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180;
+
+// A raw CoLa connection for the tests (the product's client is tested elsewhere).
+class RawCola {
+ public:
+  RawCola(uint16_t port, ColaDialect dialect) : decoder_({dialect}), dialect_(dialect) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    if (::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) throw std::runtime_error("connect failed");
+  }
+  ~RawCola() { ::close(fd_); }
+  void send(const std::string& payload) {
+    const std::string f = frameCola(dialect_, payload);
+    ASSERT_EQ(::send(fd_, f.data(), f.size(), MSG_NOSIGNAL), static_cast<ssize_t>(f.size()));
+  }
+  // Next payload whose type is not `skip_type`, within timeout; empty on timeout or close.
+  std::string next(double timeout_s = 3.0, const std::string& skip_type = "") {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    for (;;) {
+      while (auto p = decoder_.next())
+        if (skip_type.empty() || p->compare(0, 3, skip_type) != 0) return *p;
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
+      if (left.count() <= 0) return {};
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
+      char buf[8192];
+      const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+      if (n <= 0) {
+        closed_ = true;
+        return {};
+      }
+      decoder_.feed(std::string_view(buf, static_cast<size_t>(n)));
+    }
+  }
+  bool closed() const { return closed_; }
+
+ private:
+  int fd_ = -1;
+  ColaStreamDecoder decoder_;
+  ColaDialect dialect_;
+  bool closed_ = false;
+};
+
+// A cloth wall 4 m in front of the unit (along +Y of the unit frame, where the device's 90° looks at β = 0).
+Scene wallScene() {
+  Scene s;
+  s.objects.push_back({"wall", Material::Cloth,
+                       makeQuad(Vec3(-30, 4, -30), Vec3(30, 4, -30), Vec3(30, 4, 30), Vec3(-30, 4, 30))});
+  return s;
+}
+
+ScannerEmulatorParams params(ScannerModel model) {
+  ScannerEmulatorParams p;
+  p.port = 0;
+  p.sensor.model = model;
+  return p;
+}
+
+struct Recorded {
+  std::vector<std::pair<std::string, std::string>> exchanges;  // request payload, type of the device's reply
+  size_t first_scan_values = 0;
+};
+
+// Pairs each request with the next reply of the same name (the LMS111 repeats some replies: extras are skipped).
+Recorded readRecording(const std::string& file) {
+  const CaptureTelegrams tel = extractTelegrams(readCapture(std::string(SAILSHAPE_SHARED) + "/sick-recordings/" + file));
+  Recorded r;
+  std::vector<std::string> pending;
+  for (const CapturedTelegram& t : tel.telegrams) {
+    const ColaTelegram c = splitColaTelegram(t.payload);
+    if (t.direction == CaptureDirection::kToDevice) {
+      pending.push_back(t.payload);
+    } else if (c.type == "sSN") {
+      if (c.name == "LMDscandata" && r.first_scan_values == 0)
+        r.first_scan_values = decodeScanData(t.payload, ColaDialect::kBinary).channel("DIST1")->values.size();
+    } else {
+      for (auto it = pending.begin(); it != pending.end(); ++it)
+        if (splitColaTelegram(*it).name == c.name) {
+          r.exchanges.emplace_back(*it, c.type);
+          pending.erase(it);
+          break;
+        }
+    }
+  }
+  return r;
+}
+
+void answersLikeTheRecordedDevice(ScannerModel model, const std::string& file) {
+  const Recorded rec = readRecording(file);
+  ASSERT_GT(rec.exchanges.size(), 40u);
+  ASSERT_GT(rec.first_scan_values, 0u);
+  ScannerEmulator emu(wallScene(), params(model));
+  RawCola cola(emu.port(), ColaDialect::kBinary);
+  for (const auto& [req, reply_type] : rec.exchanges) {
+    const ColaTelegram q = splitColaTelegram(req);
+    cola.send(req);
+    const std::string reply = cola.next(3.0, "sSN");
+    ASSERT_FALSE(reply.empty()) << "no reply to " << q.type << " " << q.name;
+    const ColaTelegram a = splitColaTelegram(reply);
+    EXPECT_EQ(a.type, reply_type) << q.type << " " << q.name;
+    EXPECT_EQ(a.name, q.name);
+  }
+  // Streaming is on: scans carry the point count the driver's output range implies (as the device sent).
+  const std::string scan = cola.next(3.0);
+  ASSERT_FALSE(scan.empty());
+  const ScanData d = decodeScanData(scan, ColaDialect::kBinary);
+  EXPECT_EQ(d.command_type, "sSN");
+  EXPECT_EQ(d.channel("DIST1")->values.size(), rec.first_scan_values);
+  EXPECT_EQ(d.version, model == ScannerModel::Lms111 ? 1 : 0);
+}
+
+}  // namespace
+
+TEST(ScannerEmulator, Lms111AnswersTheRecordedStartupSequence) {
+  answersLikeTheRecordedDevice(ScannerModel::Lms111, "20210302_lms111.pcapng.json");
+}
+
+TEST(ScannerEmulator, Lms511AnswersTheRecordedStartupSequence) {
+  answersLikeTheRecordedDevice(ScannerModel::Lms511, "20210302_lms511.pcapng.json");
+}
+
+TEST(ScannerEmulator, StreamsRayCastRangesAtTheConfiguredRate) {
+  ScannerEmulatorParams p = params(ScannerModel::Lms511);
+  ScannerEmulator emu(wallScene(), p);
+  RawCola cola(emu.port(), ColaDialect::kBinary);
+  const auto ask = [&](const std::string& type, const std::string& name, const ColaWriter& w) {
+    cola.send(colaPayload(type, name, w.bytes()));
+    return splitColaTelegram(cola.next(3.0, "sSN"));
+  };
+  using W = ColaWriter;
+  EXPECT_EQ(ask("sMN", "SetAccessMode", W(ColaDialect::kBinary).u8(3).u32(0xF4724744u)).arguments, std::string(1, '\x01'));
+  // 50 Hz, 1°, 60°..120°: 61 values.
+  const ColaTelegram cfg = ask("sMN", "mLMPsetscancfg", W(ColaDialect::kBinary).u32(5000).u16(1).u32(10000).i32(600000).i32(1200000));
+  EXPECT_EQ(cfg.arguments[0], '\x00') << "status: no error";
+  ask("sWN", "LMDscandatacfg", W(ColaDialect::kBinary).u16(0x0100).u8(1).u8(0).u8(0).u16(0).u8(0).u8(0).u8(0).u8(0).u16(1));
+  EXPECT_EQ(ask("sMN", "LMCstartmeas", W(ColaDialect::kBinary)).type, "sAN");
+  EXPECT_EQ(ask("sMN", "Run", W(ColaDialect::kBinary)).type, "sAN");
+  EXPECT_EQ(ask("sEN", "LMDscandata", W(ColaDialect::kBinary).u8(1)).type, "sEA");
+  std::vector<ScanData> scans;
+  while (scans.size() < 10) {
+    const std::string s = cola.next(3.0);
+    ASSERT_FALSE(s.empty());
+    if (isScanDataTelegram(s)) scans.push_back(decodeScanData(s, ColaDialect::kBinary));
+  }
+  for (size_t k = 0; k < scans.size(); ++k) {
+    const ScanChannel* dist = scans[k].channel("DIST1");
+    ASSERT_NE(dist, nullptr);
+    ASSERT_EQ(dist->values.size(), 61u);
+    ASSERT_NE(scans[k].channel("RSSI1"), nullptr);
+    EXPECT_EQ(scans[k].scan_frequency, 5000u);
+    EXPECT_EQ(dist->start_angle, 600000);
+    EXPECT_EQ(dist->angular_step, 10000);
+    if (k > 0) {
+      EXPECT_EQ(scans[k].scan_counter, scans[k - 1].scan_counter + 1);
+      // Scan start stamps one period (20 ms) apart on the device clock.
+      EXPECT_EQ(scans[k].time_since_startup_us - scans[k - 1].time_since_startup_us, 20000u);
+    }
+    // The wall at 4 m: r = 4 / sin α, within 5σ of cloth noise plus the 0.3 % systematic bound.
+    for (size_t i = 0; i < dist->values.size(); ++i) {
+      const double alpha = scanAngleRad(*dist, i);
+      const double expect = 4.0 / std::sin(alpha);
+      ASSERT_GT(dist->values[i], 0u);
+      EXPECT_NEAR(scanRangeMm(*dist, i) / 1000.0, expect, 5 * 0.0041 + 0.003 * expect + 0.0005) << "beam " << i;
+    }
+  }
+  // Stop streaming: no further scan.
+  cola.send(colaPayload("sEN", "LMDscandata", W(ColaDialect::kBinary).u8(0).bytes()));
+  std::string r;
+  do r = cola.next(1.0); while (!r.empty() && r.compare(0, 3, "sSN") == 0);
+  ASSERT_EQ(r.substr(0, 3), "sEA");
+  EXPECT_TRUE(cola.next(0.2).empty());
+}
+
+TEST(ScannerEmulator, AsciiDialectAndErrors) {
+  ScannerEmulator emu(wallScene(), params(ScannerModel::Lms111));
+  RawCola cola(emu.port(), ColaDialect::kAscii);
+  cola.send("sRN FirmwareVersion");
+  const ColaTelegram fw = splitColaTelegram(cola.next());
+  EXPECT_EQ(fw.type, "sRA");
+  EXPECT_EQ(ColaReader(ColaDialect::kAscii, fw.arguments, "fw").string("version"), "V1.80.2  ");
+  cola.send("sMN LMCstartmeas");  // before login
+  EXPECT_EQ(cola.next().substr(0, 3), "sFA");
+  cola.send("sRN NoSuchVariable");
+  EXPECT_EQ(cola.next().substr(0, 3), "sFA");
+  cola.send("sMN SetAccessMode 3 12345678");  // wrong password
+  EXPECT_EQ(cola.next(), "sAN SetAccessMode 0");
+  cola.send("sMN SetAccessMode 3 F4724744");
+  EXPECT_EQ(cola.next(), "sAN SetAccessMode 1");
+  cola.send("sMN mLMPsetscancfg 1388 1 3E8 FFF92230 225510");  // 0.1° is not an LMS111 resolution
+  const ColaTelegram bad = splitColaTelegram(cola.next());
+  EXPECT_EQ(bad.type, "sAN");
+  EXPECT_NE(ColaReader(ColaDialect::kAscii, bad.arguments, "cfg").u8("status"), 0);
+  cola.send("sRN LMDscandata");  // polled scan
+  const std::string polled = cola.next();
+  const ScanData d = decodeScanData(polled, ColaDialect::kAscii);
+  EXPECT_EQ(d.command_type, "sRA");
+  EXPECT_EQ(d.channel("DIST1")->values.size(), 541u);
+}
+
+TEST(ScannerEmulator, Faults) {
+  ScannerEmulatorParams p = params(ScannerModel::Lms511);
+  p.refuse_login = true;
+  {
+    ScannerEmulator emu(wallScene(), p);
+    RawCola cola(emu.port(), ColaDialect::kBinary);
+    cola.send(colaPayload("sMN", "SetAccessMode", ColaWriter(ColaDialect::kBinary).u8(3).u32(0xF4724744u).bytes()));
+    EXPECT_EQ(splitColaTelegram(cola.next()).arguments, std::string(1, '\0'));
+  }
+  p = params(ScannerModel::Lms511);
+  p.mute = true;
+  {
+    ScannerEmulator emu(wallScene(), p);
+    RawCola cola(emu.port(), ColaDialect::kBinary);
+    cola.send("sRN FirmwareVersion");
+    EXPECT_TRUE(cola.next(0.3).empty());
+    EXPECT_FALSE(cola.closed());
+  }
+  p = params(ScannerModel::Lms511);
+  p.drop_after_scans = 3;
+  {
+    ScannerEmulator emu(wallScene(), p);
+    RawCola cola(emu.port(), ColaDialect::kBinary);
+    cola.send(colaPayload("sMN", "SetAccessMode", ColaWriter(ColaDialect::kBinary).u8(3).u32(0xF4724744u).bytes()));
+    cola.next();
+    cola.send("sMN LMCstartmeas");
+    cola.next();
+    cola.send(colaPayload("sEN", "LMDscandata", ColaWriter(ColaDialect::kBinary).u8(1).bytes()));
+    cola.next();
+    int scans = 0;
+    while (!cola.next(2.0).empty()) ++scans;
+    EXPECT_EQ(scans, 3);
+    EXPECT_TRUE(cola.closed());
+  }
+  p = params(ScannerModel::Lms511);
+  p.bind_address = "not-an-address";
+  EXPECT_THROW(ScannerEmulator(wallScene(), p), std::runtime_error);
+}
+
+TEST(ScannerEmulator, BetaFollowsTheTurntable) {
+  // p = 0, θ = 0: at β the beam at α = 90° points along (0, cos β, sin β); a floor at z = -2 is met
+  // at r = 2 / sin(-β) for β < 0.
+  Scene s;
+  s.objects.push_back({"floor", Material::Paint, makeQuad(Vec3(-30, -30, -2), Vec3(30, -30, -2), Vec3(30, 30, -2), Vec3(-30, 30, -2))});
+  EmulatedTurntableParams tp;
+  tp.home_speed_deg_s = 720;
+  tp.acceleration_deg_s2 = 3600;
+  TurntableMotion table(tp);
+  table.home();
+  while (table.status().state != TurntableState::Idle) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  table.setVelocity(360);
+  ASSERT_EQ(table.moveTo(-60), TurntableErrorCode::None);
+  while (table.status().state != TurntableState::Idle) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ScannerEmulatorParams p = params(ScannerModel::Lms511);
+  p.sensor.noise_scale = 0;
+  p.sensor.systematic_fraction = 0;
+  ScannerEmulator emu(s, p, &table);
+  // A polled scan covers the last period: let the table rest for longer than that.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const std::string polled = emu.reply("sRN LMDscandata", true);
+  const ScanData d = decodeScanData(polled, ColaDialect::kBinary);
+  const ScanChannel* dist = d.channel("DIST1");
+  const size_t i90 = static_cast<size_t>(std::lround((90.0 - scanAngleDeg(*dist, 0)) / (dist->angular_step / 10000.0)));
+  const double alpha = scanAngleRad(*dist, i90);
+  // Beam direction (cos α, sin α cos β, sin α sin β): z-component sin α sin(-60°).
+  EXPECT_NEAR(scanRangeMm(*dist, i90) / 1000.0, 2.0 / (std::sin(alpha) * std::sin(60 * kDeg)), 0.0015);
+}
