@@ -1,0 +1,223 @@
+#include "acquisition/sweep.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "acquisition/scan_data.hpp"
+#include "acquisition/scanner_client.hpp"
+#include "acquisition/turntable.hpp"
+#include "analysis/errors.hpp"
+
+namespace sailshape {
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+struct ReceivedScan {
+  ScanData data;
+  double host_time_s = 0;
+};
+
+struct TableSample {
+  double host_time_s;
+  double deg;
+};
+
+// β (degrees) at host time t from turntable samples, linear between neighbours, held outside.
+double interpolateBeta(const std::vector<TableSample>& samples, double t) {
+  if (t <= samples.front().host_time_s) return samples.front().deg;
+  if (t >= samples.back().host_time_s) return samples.back().deg;
+  const auto it = std::upper_bound(samples.begin(), samples.end(), t,
+                                   [](double v, const TableSample& s) { return v < s.host_time_s; });
+  const TableSample& b = *it;
+  const TableSample& a = *(it - 1);
+  const double f = (t - a.host_time_s) / (b.host_time_s - a.host_time_s);
+  return a.deg + f * (b.deg - a.deg);
+}
+
+double encoderDeg(const ScanData& s) {
+  return countsToDeg(static_cast<int32_t>(s.encoders.front().position));
+}
+
+
+}  // namespace
+
+Vec3 sweepPointPosition(const UnitConfig& unit, double r, double alpha, double beta) {
+  return unit.pose * unitPoint(r, alpha, beta, unit.p_m, unit.theta_rad);
+}
+
+Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progress& progress) {
+  validateUnit(unit);
+  Sweep sweep;
+  sweep.unit = unit.name;
+
+  TurntableLinkParams link;
+  link.device = unit.serial_device;
+  link.baud = unit.baud;
+  TurntableClient table(link);
+  table.setAcceleration(unit.acceleration_deg_s2);
+  if (options.home) table.home(options.home_timeout_s, progress);
+  table.setVelocity(options.positioning_speed_deg_s);
+  table.moveAbsolute(unit.start_angle_deg);
+  const double positioning_s = std::abs(unit.start_angle_deg) / options.positioning_speed_deg_s + 5.0;
+  if (!table.waitIdle(positioning_s))
+    throw TurntableError("[runSweep] " + unit.name + ": the turntable did not reach the start angle " +
+                         std::to_string(unit.start_angle_deg) + "° within " + std::to_string(positioning_s) + " s");
+
+  ScannerClientParams sp;
+  sp.host = unit.host;
+  sp.port = unit.port;
+  sp.dialect = unit.protocol == "cola-a" ? ColaDialect::kAscii : ColaDialect::kBinary;
+  sp.reply_timeout_s = options.reply_timeout_s;
+  sp.scan_timeout_s = options.scan_timeout_s;
+  sp.scan_frequency = static_cast<uint32_t>(std::lround(unit.frequency_hz * 100));
+  sp.angular_resolution = static_cast<uint32_t>(std::lround(unit.resolution_deg * 10000));
+  sp.start_angle = static_cast<int32_t>(std::lround(unit.output_start_deg * 10000));
+  sp.stop_angle = static_cast<int32_t>(std::lround(unit.output_stop_deg * 10000));
+  sp.rssi = unit.rssi;
+  sp.capture_path = options.capture_path;
+  ScannerClient scanner(sp);
+  const ScannerStartup startup = scanner.start();
+  for (const std::string& w : startup.warnings) sweep.warnings.push_back(w);
+  if (unit.beta_source == BetaSource::Encoder) {
+    // The turntable's encoder is wired to the scanner: ask for the encoder block in every scan
+    // (LMDscandatacfg: channel, remission, 8-bit, mm, encoder 1, no position/name/comment/time, every scan).
+    ColaWriter w(sp.dialect);
+    w.u16(0x0100).u8(unit.rssi ? 1 : 0).u8(0).u8(0).u16(0x0100).u8(0).u8(0).u8(0).u8(0).u16(1);
+    scanner.request("sWN", "LMDscandatacfg", w.bytes());
+  }
+
+  if (options.wait_for_start) sweep.trigger_time_s = options.wait_for_start();
+
+  std::vector<ReceivedScan> scans;
+  std::vector<TableSample> table_samples;
+  const double target = unit.start_angle_deg + unit.sweep_angle_deg;
+  table.setVelocity(unit.speed_deg_s);
+  table_samples.push_back({hostTimeSeconds(), table.sample().deg()});
+  sweep.start_time_s = hostTimeSeconds();
+  table.moveAbsolute(target);
+  const double expected_s = std::abs(unit.sweep_angle_deg) / unit.speed_deg_s +
+                            unit.speed_deg_s / unit.acceleration_deg_s2 + 2.0;
+  double last_poll = 0;
+  double idle_at = -1;
+  for (;;) {
+    const double now = hostTimeSeconds();
+    if (now - last_poll > 0.015 || idle_at < 0) {
+      const TurntableStatus st = table.status();
+      const double t = hostTimeSeconds();
+      table_samples.push_back({0.5 * (now + t), countsToDeg(st.counts)});
+      last_poll = t;
+      if (st.state == TurntableState::Error) {
+        sweep.partial = true;
+        sweep.message = "turntable fault " + turntableErrorWord(st.error);
+        break;
+      }
+      if (st.state == TurntableState::Idle && idle_at < 0) idle_at = t;
+      progress("sweep", std::clamp((countsToDeg(st.counts) - unit.start_angle_deg) / unit.sweep_angle_deg, 0.0, 1.0));
+    }
+    // One more scan after the table stopped so the last moving scan has a successor for β interpolation.
+    if (idle_at > 0 && !scans.empty() && scans.back().host_time_s > idle_at + 1.5 / unit.frequency_hz) break;
+    if (now - sweep.start_time_s > expected_s + options.scan_timeout_s) {
+      sweep.partial = true;
+      sweep.message = "the turntable did not finish the sweep within " + std::to_string(expected_s) + " s";
+      break;
+    }
+    try {
+      ScanData s = scanner.nextScan();
+      scans.push_back({std::move(s), hostTimeSeconds()});
+    } catch (const ScannerError& e) {
+      sweep.partial = true;
+      sweep.message = e.what();
+      break;
+    }
+  }
+  sweep.end_time_s = hostTimeSeconds();
+  if (sweep.partial) {
+    try {
+      table.stop();
+    } catch (const TurntableError& e) {
+      sweep.warnings.push_back(std::string("stopping the turntable: ") + e.what());
+    }
+  }
+  try {
+    if (scanner.connected()) scanner.stop();
+  } catch (const ScannerError& e) {
+    sweep.warnings.push_back(std::string("stop sequence: ") + e.what());
+  }
+  table_samples.push_back({hostTimeSeconds(), table.sample().deg()});
+
+  // Scans taken before the move was commanded stand at the start angle: not part of the sweep.
+  // Timestamp mode maps the scanner's clock to the host's by the smallest receive − transmission gap.
+  double clock_offset = std::numeric_limits<double>::infinity();
+  for (const ReceivedScan& r : scans)
+    clock_offset = std::min(clock_offset, r.host_time_s - r.data.time_of_transmission_us * 1e-6);
+  const bool encoder = unit.beta_source == BetaSource::Encoder;
+  size_t used = 0;
+  for (size_t k = 0; k < scans.size(); ++k) {
+    const ScanData& s = scans[k].data;
+    const ScanChannel* dist = s.channel("DIST1");
+    if (!dist || dist->values.empty()) {
+      sweep.warnings.push_back("scan " + std::to_string(s.scan_counter) + " has no DIST1 channel: skipped");
+      continue;
+    }
+    const ScanChannel* rssi = s.channel("RSSI1");
+    const double period_s = s.scan_frequency > 0 ? 100.0 / s.scan_frequency : 1.0 / unit.frequency_hz;
+    const double scan_host_start = s.time_since_startup_us * 1e-6 + clock_offset;
+    if (scan_host_start < sweep.start_time_s - period_s) continue;
+    double beta0 = 0, beta_rate = 0;  // degrees at the first beam, degrees per period
+    if (encoder) {
+      if (s.encoders.empty()) {
+        sweep.warnings.push_back("scan " + std::to_string(s.scan_counter) +
+                                 " has no encoder block although beta_source is encoder: skipped");
+        continue;
+      }
+      beta0 = encoderDeg(s);
+      // Per-beam β: the encoder advances linearly to the next scan's reading, one period per scan counter step.
+      const ScanData* next = k + 1 < scans.size() ? &scans[k + 1].data : nullptr;
+      const ScanData* prev = k > 0 ? &scans[k - 1].data : nullptr;
+      if (next && !next->encoders.empty() && next->scan_counter != s.scan_counter)
+        beta_rate = (encoderDeg(*next) - beta0) / static_cast<uint16_t>(next->scan_counter - s.scan_counter);
+      else if (prev && !prev->encoders.empty() && prev->scan_counter != s.scan_counter)
+        beta_rate = (beta0 - encoderDeg(*prev)) / static_cast<uint16_t>(s.scan_counter - prev->scan_counter);
+    }
+    ++used;
+    sweep.beams += dist->values.size();
+    const double first_alpha_deg = scanAngleDeg(*dist, 0);
+    for (size_t i = 0; i < dist->values.size(); ++i) {
+      if (dist->values[i] == 0) continue;  // no echo
+      SweepPoint p;
+      p.range_m = scanRangeMm(*dist, i) / 1000.0;
+      p.alpha_rad = scanAngleRad(*dist, i);
+      const double frac = (scanAngleDeg(*dist, i) - first_alpha_deg) / 360.0;
+      p.time_s = scan_host_start + frac * period_s;
+      const double beta_deg = encoder ? beta0 + frac * beta_rate : interpolateBeta(table_samples, p.time_s);
+      p.beta_rad = beta_deg * kDeg;
+      if (rssi && i < rssi->values.size()) p.rssi = static_cast<uint8_t>(std::min<uint16_t>(rssi->values[i], 255));
+      sweep.points.push_back(p);
+    }
+  }
+  sweep.scans = used;
+  if (!sweep.points.empty()) {
+    sweep.beta_start_deg = sweep.points.front().beta_rad / kDeg;
+    sweep.beta_end_deg = sweep.points.back().beta_rad / kDeg;
+  }
+  sweep.cloud.viewpoint = unit.pose.translation();
+  sweep.cloud.points.reserve(sweep.points.size());
+  for (const SweepPoint& p : sweep.points) {
+    sweep.cloud.points.push_back(sweepPointPosition(unit, p.range_m, p.alpha_rad, p.beta_rad));
+    sweep.cloud.alpha_rad.push_back(p.alpha_rad);
+    sweep.cloud.beta_rad.push_back(p.beta_rad);
+    sweep.cloud.intensity.push_back(p.rssi);
+  }
+  if (!sweep.partial && used == 0) {
+    sweep.partial = true;
+    sweep.message = "no scan arrived while the turntable moved";
+  }
+  progress("sweep", 1.0);
+  return sweep;
+}
+
+}  // namespace sailshape

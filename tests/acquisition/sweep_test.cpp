@@ -1,0 +1,210 @@
+// Sweeps end to end: the client drives the emulated turntable through a real pty and the emulated
+// scanner through a real TCP socket; clouds of known shapes reconstruct within SPEC §3's noise model.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "acquisition/emulated_turntable.hpp"
+#include "acquisition/scanner_client.hpp"
+#include "acquisition/scanner_emulator.hpp"
+#include "acquisition/sweep.hpp"
+#include "acquisition/turntable.hpp"
+#include "analysis/errors.hpp"
+
+using namespace sailshape;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180;
+constexpr double kSigmaCloth = 0.0041;  // SPEC §3
+
+// One emulated unit: drive on a pty, scanner on an ephemeral port, sharing the drive's motion.
+struct Rig {
+  EmulatedTurntable table;
+  ScannerEmulator scanner;
+  UnitConfig unit;
+  Rig(const Scene& scene, const UnitConfig& u, const ScannerEmulatorParams& sp, const EmulatedTurntableParams& tp)
+      : table(tp), scanner(scene, sp, &table.motion()), unit(u) {
+    unit.port = scanner.port();
+    unit.serial_device = table.devicePath();
+  }
+};
+
+EmulatedTurntableParams fastTable() {
+  EmulatedTurntableParams p;
+  p.home_speed_deg_s = 720;
+  p.acceleration_deg_s2 = 3600;
+  return p;
+}
+
+// A compact sweep: LMS511 at 50 Hz, 1°, α 60°..120°, β −20°..+20° at 40 °/s.
+UnitConfig compactUnit(double p_m, double theta_deg) {
+  UnitConfig u;
+  u.name = "test-unit";
+  u.model = ScannerModel::Lms511;
+  u.p_m = p_m;
+  u.theta_rad = theta_deg * kDeg;
+  u.frequency_hz = 50;
+  u.resolution_deg = 1.0;
+  u.output_start_deg = 60;
+  u.output_stop_deg = 120;
+  u.start_angle_deg = -20;
+  u.sweep_angle_deg = 40;
+  u.speed_deg_s = 40;
+  u.acceleration_deg_s2 = 400;
+  return u;
+}
+
+ScannerEmulatorParams emulatorFor(const UnitConfig& u) {
+  ScannerEmulatorParams p;
+  p.port = 0;
+  p.sensor.model = u.model;
+  p.p_m = u.p_m;
+  p.theta_rad = u.theta_rad;
+  p.pose = u.pose;
+  return p;
+}
+
+Scene wallAt(double y) {
+  Scene s;
+  s.objects.push_back({"wall", Material::Cloth, makeQuad(Vec3(-20, y, -20), Vec3(20, y, -20), Vec3(20, y, 20), Vec3(-20, y, 20))});
+  return s;
+}
+
+struct PlaneFit {
+  Vec3 normal, centroid;
+  double rms = 0;
+};
+PlaneFit fitPlane(const std::vector<Vec3>& pts) {
+  PlaneFit f;
+  f.centroid = Vec3::Zero();
+  for (const Vec3& p : pts) f.centroid += p;
+  f.centroid /= pts.size();
+  Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : pts) c += (p - f.centroid) * (p - f.centroid).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(c);
+  f.normal = es.eigenvectors().col(0);
+  for (const Vec3& p : pts) f.rms += std::pow((p - f.centroid).dot(f.normal), 2);
+  f.rms = std::sqrt(f.rms / pts.size());
+  return f;
+}
+
+void checkPlaneSweep(BetaSource source) {
+  UnitConfig u = compactUnit(0.12, 25);
+  u.beta_source = source;
+  u.pose = makePose(Vec3(0.5, -1.0, 2.0), 0, 0, 0.3);
+  // The wall y = 3 in the unit frame, placed in the scene through the pose.
+  Scene scene;
+  const Vec3 c[4] = {Vec3(-20, 3, -20), Vec3(20, 3, -20), Vec3(20, 3, 20), Vec3(-20, 3, 20)};
+  scene.objects.push_back({"wall", Material::Cloth, makeQuad(u.pose * c[0], u.pose * c[1], u.pose * c[2], u.pose * c[3])});
+  Rig rig(scene, u, emulatorFor(u), fastTable());
+  const Sweep s = runSweep(rig.unit);
+  ASSERT_FALSE(s.partial) << s.message;
+  EXPECT_GE(s.scans, 40u);  // ≈ 1.1 s of motion at 50 Hz
+  EXPECT_EQ(s.cloud.size(), s.points.size());
+  EXPECT_GT(s.points.size(), 0.9 * s.beams);
+  EXPECT_NEAR(s.beta_start_deg, -20, 1.0);
+  EXPECT_NEAR(s.beta_end_deg, 20, 1.0);
+  const PlaneFit f = fitPlane(s.cloud.points);
+  EXPECT_LE(f.rms, 1.5 * kSigmaCloth) << "plane RMS residual";
+  // The fitted plane is the true one (normal along the pose's Y), offset by at most the systematic error.
+  const Vec3 n_true = u.pose.linear() * Vec3::UnitY();
+  EXPECT_GT(std::abs(f.normal.dot(n_true)), std::cos(0.2 * kDeg));
+  const double offset = (f.centroid - u.pose * Vec3(0, 3, 0)).dot(n_true);
+  EXPECT_GT(offset, -3 * kSigmaCloth / std::sqrt(double(s.points.size())));
+  EXPECT_LT(offset, 0.003 * 3.6);  // SPEC §3: ≤ 0.3 % of the longest range (3 m / sin 60° ≈ 3.5 m)
+  // Samples keep r, α, β, RSSI and time.
+  for (const SweepPoint& p : s.points) {
+    ASSERT_GE(p.alpha_rad, 60 * kDeg - 1e-9);
+    ASSERT_LE(p.alpha_rad, 120 * kDeg + 1e-9);
+    ASSERT_GT(p.rssi, 0);
+    ASSERT_GE(p.time_s, s.start_time_s - 0.05);
+  }
+}
+
+}  // namespace
+
+TEST(Sweep, PlaneWithEncoderBeta) { checkPlaneSweep(BetaSource::Encoder); }
+
+TEST(Sweep, PlaneWithTimestampBeta) { checkPlaneSweep(BetaSource::Timestamp); }
+
+TEST(Sweep, CylinderAtAKnownPosition) {
+  // A vertical cylinder of radius 0.4 m, axis through (0.3, 3, ·) in the unit frame; no background.
+  UnitConfig u = compactUnit(0.1, -15);
+  u.output_start_deg = 70;
+  u.output_stop_deg = 110;
+  const double radius = 0.4;
+  const Vec3 axis_point(0.3, 3.0, -5.0);
+  Scene scene;
+  scene.objects.push_back({"cylinder", Material::Cloth, makeCylinder(axis_point, Vec3::UnitZ(), radius, 10.0, 720)});
+  Rig rig(scene, u, emulatorFor(u), fastTable());
+  const Sweep s = runSweep(rig.unit);
+  ASSERT_FALSE(s.partial) << s.message;
+  ASSERT_GT(s.points.size(), 500u);
+  double sum = 0, sum2 = 0;
+  for (const Vec3& p : s.cloud.points) {
+    const double d = std::hypot(p.x() - axis_point.x(), p.y() - axis_point.y()) - radius;
+    sum += d;
+    sum2 += d * d;
+  }
+  const double n = s.cloud.size(), mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  // The 720-facet cylinder lies within 0.4·(1 − cos 0.25°) ≈ 4 µm of the true one.
+  EXPECT_LE(sd, 1.5 * kSigmaCloth);
+  // A range too long puts the point behind the surface the scanner sees, i.e. inside the cylinder:
+  // the mean residual lies between minus the systematic bound and zero (plus its sampling error).
+  EXPECT_LT(mean, 3 * kSigmaCloth / std::sqrt(n));
+  EXPECT_GT(mean, -0.003 * 3.2);
+}
+
+TEST(Sweep, ConnectionDroppedMidSweepKeepsThePartialSweep) {
+  UnitConfig u = compactUnit(0.1, 0);
+  ScannerEmulatorParams sp = emulatorFor(u);
+  sp.drop_after_scans = 30;  // a few before the move starts, the rest during it
+  Rig rig(wallAt(3), u, sp, fastTable());
+  Sweep s;
+  ASSERT_NO_THROW(s = runSweep(rig.unit));
+  EXPECT_TRUE(s.partial);
+  EXPECT_FALSE(s.message.empty());
+  EXPECT_GT(s.points.size(), 0u);
+  EXPECT_LT(s.scans, 30u);
+  EXPECT_EQ(s.cloud.size(), s.points.size());
+  // The turntable was stopped short of the sweep's end.
+  EXPECT_LT(s.beta_end_deg, 20.0);
+}
+
+TEST(Sweep, TurntableThatNeverFindsHome) {
+  EmulatedTurntableParams tp = fastTable();
+  tp.home_sensor_works = false;
+  tp.home_search_deg = 60;
+  UnitConfig u = compactUnit(0.1, 0);
+  Rig rig(wallAt(3), u, emulatorFor(u), tp);
+  try {
+    runSweep(rig.unit);
+    ADD_FAILURE() << "a sweep cannot start without home";
+  } catch (const TurntableError& e) {
+    EXPECT_EQ(e.code, TurntableErrorCode::HomeNotFound);
+  }
+  EXPECT_EQ(rig.scanner.connections(), 0u) << "nothing streamed before the table was homed";
+}
+
+TEST(Sweep, RefusedLoginAndSilentScanner) {
+  UnitConfig u = compactUnit(0.1, 0);
+  ScannerEmulatorParams sp = emulatorFor(u);
+  sp.refuse_login = true;
+  {
+    Rig rig(wallAt(3), u, sp, fastTable());
+    EXPECT_THROW(runSweep(rig.unit), ScannerError);
+  }
+  sp = emulatorFor(u);
+  sp.mute = true;
+  {
+    Rig rig(wallAt(3), u, sp, fastTable());
+    SweepOptions o;
+    o.reply_timeout_s = 0.3;
+    EXPECT_THROW(runSweep(rig.unit, o), ScannerError);
+  }
+  UnitConfig bad = u;
+  bad.speed_deg_s = 0;
+  EXPECT_THROW(runSweep(bad), InvalidInput);
+}
