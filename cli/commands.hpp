@@ -10,5 +10,6 @@ void addSimulateCommand(CLI::App& app);
 void addDesignCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addDbCommand(CLI::App& app);
+void addReplayCommand(CLI::App& app);
 
 }  // namespace sailshape::cli

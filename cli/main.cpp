@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   sailshape::cli::addDesignCommand(app);
   sailshape::cli::addCompareCommand(app);
   sailshape::cli::addDbCommand(app);
+  sailshape::cli::addReplayCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

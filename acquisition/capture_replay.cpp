@@ -1,0 +1,129 @@
+#include "acquisition/capture_replay.hpp"
+
+#include <nlohmann/json.hpp>
+
+namespace sailshape {
+
+ReplayResult replayCapture(const std::string& path, const Progress& progress) {
+  progress("read capture", 0.0);
+  const Capture capture = readCapture(path);
+  progress("read capture", 1.0);
+  const CaptureTelegrams telegrams = extractTelegrams(capture);
+  ReplayResult out;
+  out.format = capture.format;
+  out.dialect = capture.dialect;
+  out.warnings = capture.warnings;
+  out.to_device = telegrams.to_device;
+  out.from_device = telegrams.from_device;
+  const size_t n = telegrams.telegrams.size();
+  for (size_t i = 0; i < n; ++i) {
+    const CapturedTelegram& t = telegrams.telegrams[i];
+    if (isScanDataTelegram(t.payload)) {
+      try {
+        out.frames.push_back({t.time_s, decodeScanData(t.payload, capture.dialect)});
+      } catch (const ColaError& e) {
+        ++out.undecodable;
+        if (out.undecodable <= 10) out.warnings.push_back(std::string("undecodable frame: ") + e.what());
+      }
+    } else {
+      try {
+        const ColaTelegram split = splitColaTelegram(t.payload);
+        ++out.other_telegrams[split.name.empty() ? split.type : split.type + " " + split.name];
+      } catch (const ColaError&) {
+        ++out.other_telegrams["(not a telegram)"];
+      }
+    }
+    if (i % 256 == 0) progress("decode", static_cast<double>(i) / static_cast<double>(n));
+  }
+  progress("decode", 1.0);
+  return out;
+}
+
+namespace {
+
+nlohmann::json channelJson(const ScanChannel& c) {
+  return {{"name", c.name},
+          {"scale_factor", c.scale_factor},
+          {"scale_offset", c.scale_offset},
+          {"start_angle", c.start_angle},
+          {"start_angle_deg", c.start_angle / 10000.0},
+          {"angular_step", c.angular_step},
+          {"angular_step_deg", c.angular_step / 10000.0},
+          {"count", c.values.size()},
+          {"values", c.values}};
+}
+
+}  // namespace
+
+nlohmann::json scanDataJson(const ScanData& s) {
+  nlohmann::json j;
+  j["command_type"] = s.command_type;
+  j["version"] = s.version;
+  j["device_number"] = s.device_number;
+  j["serial_number"] = s.serial_number;
+  j["device_status"] = s.device_status;
+  j["telegram_counter"] = s.telegram_counter;
+  j["scan_counter"] = s.scan_counter;
+  j["time_since_startup_us"] = s.time_since_startup_us;
+  j["time_of_transmission_us"] = s.time_of_transmission_us;
+  j["digital_inputs"] = s.digital_inputs;
+  j["digital_outputs"] = s.digital_outputs;
+  j["layer_angle"] = s.layer_angle;
+  j["scan_frequency"] = s.scan_frequency;
+  j["scan_frequency_hz"] = s.scan_frequency / 100.0;
+  j["measurement_frequency"] = s.measurement_frequency;
+  j["measurement_frequency_hz"] = s.measurement_frequency * 100.0;
+  j["encoders"] = nlohmann::json::array();
+  for (const ScanEncoder& e : s.encoders) j["encoders"].push_back({{"position", e.position}, {"speed", e.speed}});
+  j["channels16"] = nlohmann::json::array();
+  for (const ScanChannel& c : s.channels16) j["channels16"].push_back(channelJson(c));
+  j["channels8"] = nlohmann::json::array();
+  for (const ScanChannel& c : s.channels8) j["channels8"].push_back(channelJson(c));
+  if (s.position) {
+    const ScanPosition& p = *s.position;
+    j["position"] = {{"x", p.x},           {"y", p.y},         {"z", p.z},
+                     {"rot_x", p.rot_x},   {"rot_y", p.rot_y}, {"rot_z", p.rot_z},
+                     {"rotation_type", p.rotation_type}, {"transmit_device_name", p.transmit_device_name}};
+  }
+  if (s.device_name) j["device_name"] = *s.device_name;
+  if (s.comment) j["comment"] = *s.comment;
+  if (s.time) {
+    const ScanTime& t = *s.time;
+    j["time"] = {{"year", t.year},     {"month", t.month},   {"day", t.day},
+                 {"hour", t.hour},     {"minute", t.minute}, {"second", t.second},
+                 {"microsecond", t.microsecond}};
+  }
+  if (s.event_info) {
+    const ScanEventInfo& e = *s.event_info;
+    j["event_info"] = {{"type", e.type}, {"encoder_position", e.encoder_position}, {"time_us", e.time_us}, {"angle", e.angle}};
+  }
+  return j;
+}
+
+nlohmann::json replayJson(const ReplayResult& r) {
+  auto stats = [](const ColaStreamStats& s) {
+    return nlohmann::json{{"frames", s.frames},
+                          {"bad_checksum", s.bad_checksum},
+                          {"bad_length", s.bad_length},
+                          {"unterminated", s.unterminated},
+                          {"garbage_bytes", s.garbage_bytes}};
+  };
+  nlohmann::json j;
+  j["format"] = r.format;
+  j["dialect"] = colaDialectName(r.dialect);
+  j["scan_frames"] = r.frames.size();
+  j["undecodable_scan_frames"] = r.undecodable;
+  j["to_device"] = stats(r.to_device);
+  j["from_device"] = stats(r.from_device);
+  j["other_telegrams"] = r.other_telegrams;
+  j["warnings"] = r.warnings;
+  j["frames"] = nlohmann::json::array();
+  for (const ReplayFrame& f : r.frames) {
+    nlohmann::json fj = scanDataJson(f.scan);
+    fj["time_s"] = f.time_s;
+    j["frames"].push_back(std::move(fj));
+  }
+  return j;
+}
+
+}  // namespace sailshape

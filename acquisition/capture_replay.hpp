@@ -1,0 +1,40 @@
+#pragma once
+// Decoding a capture again (`sailshape replay`): every LMDscandata frame with its time stamp, plus what else
+// the capture holds, and the frames as JSON (counters, frequencies, channels with the raw values as sent).
+#include <cstddef>
+#include <map>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "acquisition/capture.hpp"
+#include "acquisition/scan_data.hpp"
+#include "analysis/progress.hpp"
+
+namespace sailshape {
+
+struct ReplayFrame {
+  double time_s = 0;  // time stamp of the record that completed the frame (see CaptureRecord::time_s)
+  ScanData scan;
+};
+
+struct ReplayResult {
+  std::string format;  // "sscap" or "pcapng-json"
+  ColaDialect dialect = ColaDialect::kBinary;
+  std::vector<ReplayFrame> frames;                  // sSN and sRA LMDscandata, in capture order
+  std::map<std::string, size_t> other_telegrams;    // "sRN FirmwareVersion" -> count, both directions
+  size_t undecodable = 0;                           // LMDscandata frames with a good checksum that did not decode
+  ColaStreamStats to_device, from_device;
+  std::vector<std::string> warnings;                // from reading the capture and from undecodable frames
+};
+
+// Reads and decodes `path` (either capture format). Throws FileError as readCapture does; bad frames are
+// counted, not thrown.
+ReplayResult replayCapture(const std::string& path, const Progress& progress = {});
+
+// One frame: every field of ScanData (angles in 1/10000 degree and Hz fields as sent, plus *_hz and *_deg).
+nlohmann::json scanDataJson(const ScanData& scan);
+// The whole replay: source, statistics, other telegrams and "frames" (each scanDataJson + "time_s").
+nlohmann::json replayJson(const ReplayResult& replay);
+
+}  // namespace sailshape

@@ -1,0 +1,113 @@
+// Runs `sailshape replay` as a user would, on SICK's recordings and on captures of ours.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <string>
+
+#include "acquisition/capture.hpp"
+#include "acquisition/scan_data.hpp"
+#include "tests/cli/run_sailshape.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using sailshape::testing::Outcome;
+using sailshape::testing::readText;
+
+class ReplayCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("sailshape-replaycli-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  Outcome run(const std::string& args) { return sailshape::testing::runSailshape(dir_, args); }
+  fs::path dir_;
+};
+
+const std::string kRecordings = std::string(SAILSHAPE_SHARED) + "/sick-recordings/";
+
+TEST_F(ReplayCli, RecordingToJsonKeepsTheRawValues) {
+  const fs::path out = dir_ / "frames.json";
+  const Outcome r = run("replay " + kRecordings + "20210302_lms511.pcapng.json --quiet --json " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("pcapng-json capture, CoLa binary"), std::string::npos) << r.out;
+  const nlohmann::json doc = nlohmann::json::parse(readText(out));
+  ASSERT_GE(doc["frames"].size(), 100u);
+  EXPECT_EQ(doc["from_device"]["bad_checksum"], 0);
+  // README facts for the first frame.
+  const nlohmann::json& f = doc["frames"][0];
+  EXPECT_EQ(f["command_type"], "sSN");
+  EXPECT_EQ(f["telegram_counter"], 54098);
+  EXPECT_EQ(f["scan_counter"], 54484);
+  EXPECT_EQ(f["scan_frequency"], 2500);
+  EXPECT_DOUBLE_EQ(f["scan_frequency_hz"].get<double>(), 25.0);
+  ASSERT_EQ(f["channels16"].size(), 1u);
+  ASSERT_EQ(f["channels8"].size(), 1u);
+  const nlohmann::json& dist = f["channels16"][0];
+  EXPECT_EQ(dist["name"], "DIST1");
+  EXPECT_EQ(dist["scale_factor"], 1.0);
+  EXPECT_EQ(dist["scale_offset"], 0.0);
+  EXPECT_EQ(dist["start_angle"], -50000);
+  EXPECT_EQ(dist["angular_step"], 1667);
+  const auto values = dist["values"].get<std::vector<uint64_t>>();
+  ASSERT_EQ(values.size(), 1141u);
+  EXPECT_EQ(std::vector<uint64_t>(values.begin(), values.begin() + 5), (std::vector<uint64_t>{1305, 1299, 1307, 1299, 1307}));
+  EXPECT_EQ(std::accumulate(values.begin(), values.end(), uint64_t{0}), 1480058u);
+  const auto rssi = f["channels8"][0]["values"].get<std::vector<uint64_t>>();
+  EXPECT_EQ(f["channels8"][0]["name"], "RSSI1");
+  EXPECT_EQ(std::accumulate(rssi.begin(), rssi.end(), uint64_t{0}), 266142u);
+  EXPECT_EQ(doc["other_telegrams"]["sMN SetAccessMode"], 1);
+}
+
+TEST_F(ReplayCli, OurCaptureCutShortIsReplayedUpToTheCut) {
+  const fs::path cap = dir_ / "session.sscap";
+  {
+    sailshape::CaptureWriter w(cap.string(), sailshape::ColaDialect::kAscii);
+    for (uint16_t i = 1; i <= 3; ++i) {
+      sailshape::ScanData s;
+      s.scan_counter = i;
+      s.scan_frequency = 5000;
+      s.channels16 = {{"DIST1", 1.0f, 0.0f, -450000, 5000, {1000, 1001, 1002}}};
+      const std::string frame = sailshape::frameCola(sailshape::ColaDialect::kAscii,
+                                                     sailshape::encodeScanData(s, sailshape::ColaDialect::kAscii));
+      // Split across two records as a socket may deliver it.
+      w.append({sailshape::CaptureDirection::kFromDevice, 100.0 + i, frame.substr(0, 10)});
+      w.append({sailshape::CaptureDirection::kFromDevice, 100.0 + i, frame.substr(10)});
+    }
+  }
+  fs::resize_file(cap, fs::file_size(cap) - 5);  // a crash mid-record
+  const fs::path out = dir_ / "frames.json";
+  const Outcome r = run("replay " + cap.string() + " --quiet --json " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: truncated record"), std::string::npos) << r.err;
+  const nlohmann::json doc = nlohmann::json::parse(readText(out));
+  EXPECT_EQ(doc["dialect"], "ascii");
+  ASSERT_EQ(doc["frames"].size(), 2u);  // the third frame's second half was cut
+  EXPECT_EQ(doc["frames"][1]["scan_counter"], 2);
+  EXPECT_DOUBLE_EQ(doc["frames"][1]["time_s"].get<double>(), 102.0);
+  EXPECT_EQ(doc["frames"][0]["channels16"][0]["values"], nlohmann::json({1000, 1001, 1002}));
+}
+
+TEST_F(ReplayCli, BadInputIsOneLineError) {
+  const fs::path junk = dir_ / "junk.bin";
+  std::ofstream(junk) << "this is not a capture";
+  const Outcome r = run("replay " + junk.string() + " --quiet");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("neither a sailshape capture"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const Outcome missing = run("replay " + (dir_ / "none.sscap").string());
+  EXPECT_NE(missing.exit_code, 0);
+  const Outcome help = run("replay --help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("--json"), std::string::npos);
+}
+
+}  // namespace
