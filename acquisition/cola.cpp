@@ -79,15 +79,16 @@ ColaTelegram splitColaTelegram(std::string_view payload) {
     throw ColaError("[splitColaTelegram] not a CoLa telegram: '" + printable(payload) + "'");
   ColaTelegram t;
   t.type = std::string(payload.substr(0, 3));
-  if (payload.size() == 3) return t;
   if (t.type == "sFA") {
+    if (payload.size() == 3) return t;
     // Error reply: binary "sFA" + u16 code, ASCII "sFA <code>".
     size_t from = payload[3] == ' ' ? 4 : 3;
     t.space_after_name = false;
     t.arguments = std::string(payload.substr(from));
     return t;
   }
-  if (payload[3] != ' ') throw ColaError("[splitColaTelegram] no space after type: '" + printable(payload) + "'");
+  if (payload.size() == 3 || payload[3] != ' ')
+    throw ColaError("[splitColaTelegram] no name after the type: '" + printable(payload) + "'");
   const size_t name_end = payload.find(' ', 4);
   if (name_end == std::string_view::npos) {
     t.name = std::string(payload.substr(4));

@@ -31,11 +31,17 @@ uint16_t checkedCount(size_t n, const char* what) {
   return static_cast<uint16_t>(n);
 }
 
+// Fixed-size texts: any bytes in CoLa B; in CoLa A they are tokens, so no spaces.
+void checkFixedText(const std::string& text, size_t chars, const char* what, ColaDialect dialect) {
+  if (text.size() != chars || (dialect == ColaDialect::kAscii && text.find(' ') != std::string::npos))
+    throw ColaError(std::string("[encodeScanData] ") + what + " must be " + std::to_string(chars) +
+                    " characters (without spaces in CoLa A); got '" + text + "'");
+}
+
 void writeChannels(ColaWriter& w, const std::vector<ScanChannel>& channels, bool eight_bit) {
   w.u16(checkedCount(channels.size(), eight_bit ? "number of 8-bit channels" : "number of 16-bit channels"));
   for (const ScanChannel& c : channels) {
-    if (c.name.size() != kChannelNameChars || c.name.find(' ') != std::string::npos)
-      throw ColaError("[encodeScanData] channel name must be 5 characters without spaces (got '" + c.name + "')");
+    checkFixedText(c.name, kChannelNameChars, "channel name", w.dialect());
     w.fixedString(c.name).f32(c.scale_factor).f32(c.scale_offset).i32(c.start_angle).u16(c.angular_step);
     w.u16(checkedCount(c.values.size(), "number of values"));
     for (uint16_t v : c.values) {
@@ -172,8 +178,7 @@ std::string encodeScanData(const ScanData& s, ColaDialect dialect) {
   w.u16(s.event_info ? 1 : 0);
   if (s.event_info) {
     const ScanEventInfo& e = *s.event_info;
-    if (e.type.size() != kEventTypeChars || e.type.find(' ') != std::string::npos)
-      throw ColaError("[encodeScanData] event type must be 4 characters without spaces (got '" + e.type + "')");
+    checkFixedText(e.type, kEventTypeChars, "event type", dialect);
     w.fixedString(e.type).u32(e.encoder_position).u32(e.time_us).i32(e.angle);
   }
   return s.command_type + " LMDscandata " + w.bytes();

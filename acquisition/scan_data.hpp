@@ -102,7 +102,8 @@ bool isScanDataTelegram(std::string_view payload);
 // field (named in the message), a channel name of other than 5 characters, or bytes after the last block.
 ScanData decodeScanData(std::string_view payload, ColaDialect dialect);
 
-// The payload of `scan`. Throws ColaError when a channel name is not 5 characters, an event type not 4,
+// The payload of `scan`. Throws ColaError when a channel name is not 5 characters or an event type not 4
+// (in CoLa A also when they hold a space),
 // a count exceeds 65535, or an 8-bit channel holds a value over 255.
 std::string encodeScanData(const ScanData& scan, ColaDialect dialect);
 

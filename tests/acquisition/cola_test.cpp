@@ -73,6 +73,8 @@ TEST(ColaTelegramSplit, TypeNameArgumentsAndTrailingSpace) {
   EXPECT_THROW(splitColaTelegram("xRN foo"), ColaError);
   EXPECT_THROW(splitColaTelegram("sRNfoo"), ColaError);
   EXPECT_THROW(splitColaTelegram("sRN "), ColaError);
+  EXPECT_THROW(splitColaTelegram("sRN"), ColaError);  // found by the fuzz target: it re-joined as "sRN "
+  EXPECT_EQ(splitColaTelegram("sFA").type, "sFA");
   EXPECT_EQ(colaPayload("sEN", "LMDscandata", "1"), "sEN LMDscandata 1");
 }
 

@@ -293,6 +293,9 @@ TEST(ScanDataErrors, MalformedTelegramsNameTheProblem) {
   ScanData bad = fullScan();
   bad.channels16[0].name = "DIST";
   EXPECT_THROW(encodeScanData(bad, ColaDialect::kBinary), ColaError);
+  bad.channels16[0].name = "DI T1";  // any 5 bytes in CoLa B, but a CoLa A token cannot hold a space
+  EXPECT_NO_THROW(encodeScanData(bad, ColaDialect::kBinary));
+  EXPECT_THROW(encodeScanData(bad, ColaDialect::kAscii), ColaError);
   bad = fullScan();
   bad.channels8[0].values[0] = 256;
   EXPECT_THROW(encodeScanData(bad, ColaDialect::kAscii), ColaError);
