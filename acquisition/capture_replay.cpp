@@ -1,6 +1,12 @@
 #include "acquisition/capture_replay.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
+
+#include "acquisition/sweep.hpp"
+#include "acquisition/turntable_protocol.hpp"
+#include "analysis/errors.hpp"
 
 namespace sailshape {
 
@@ -36,6 +42,64 @@ ReplayResult replayCapture(const std::string& path, const Progress& progress) {
     if (i % 256 == 0) progress("decode", static_cast<double>(i) / static_cast<double>(n));
   }
   progress("decode", 1.0);
+  return out;
+}
+
+namespace {
+
+double encoderDeg(const ScanData& s) { return countsToDeg(static_cast<int32_t>(s.encoders.front().position)); }
+
+}  // namespace
+
+ReplayCloud replayToCloud(const ReplayResult& replay, const UnitConfig& unit) {
+  validateUnit(unit);
+  ReplayCloud out;
+  size_t without_encoder = 0, without_dist = 0;
+  const auto& frames = replay.frames;
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const ScanData& s = frames[k].scan;
+    const ScanChannel* dist = s.channel("DIST1");
+    if (dist == nullptr || dist->values.empty()) {
+      ++without_dist;
+      continue;
+    }
+    if (s.encoders.empty()) {
+      ++without_encoder;
+      continue;
+    }
+    // β advances over one mirror turn towards the next frame's reading (or at the previous frame's rate).
+    const double beta0 = encoderDeg(s);
+    double rate_deg_per_turn = 0;
+    const ScanData* next = k + 1 < frames.size() ? &frames[k + 1].scan : nullptr;
+    const ScanData* prev = k > 0 ? &frames[k - 1].scan : nullptr;
+    if (next && !next->encoders.empty() && next->scan_counter != s.scan_counter)
+      rate_deg_per_turn = (encoderDeg(*next) - beta0) / static_cast<uint16_t>(next->scan_counter - s.scan_counter);
+    else if (prev && !prev->encoders.empty() && prev->scan_counter != s.scan_counter)
+      rate_deg_per_turn = (beta0 - encoderDeg(*prev)) / static_cast<uint16_t>(s.scan_counter - prev->scan_counter);
+    const ScanChannel* rssi = s.channel("RSSI1");
+    ++out.scans_used;
+    out.beams += dist->values.size();
+    const double alpha0_deg = scanAngleDeg(*dist, 0);
+    for (size_t i = 0; i < dist->values.size(); ++i) {
+      if (dist->values[i] == 0) continue;
+      const double range_m = scanRangeMm(*dist, i) / 1000.0;
+      const double alpha_deg = scanAngleDeg(*dist, i);
+      const double beta_deg = beta0 + (alpha_deg - alpha0_deg) / 360.0 * rate_deg_per_turn;
+      const double alpha = alpha_deg * M_PI / 180.0, beta = beta_deg * M_PI / 180.0;
+      out.cloud.points.push_back(sweepPointPosition(unit, range_m, alpha, beta));
+      out.cloud.alpha_rad.push_back(alpha);
+      out.cloud.beta_rad.push_back(beta);
+      out.cloud.intensity.push_back(rssi && i < rssi->values.size() ? static_cast<float>(rssi->values[i]) : 0.0f);
+    }
+  }
+  if (out.scans_used == 0)
+    throw InvalidInput("[replayToCloud] none of the " + std::to_string(frames.size()) +
+                       " LMDscandata frames has both DIST1 and an encoder block, so the turntable angle β is "
+                       "unknown (a scanner capture holds no turntable positions)");
+  if (without_encoder > 0)
+    out.warnings.push_back(std::to_string(without_encoder) + " frames without an encoder block skipped (β unknown)");
+  if (without_dist > 0) out.warnings.push_back(std::to_string(without_dist) + " frames without DIST1 skipped");
+  out.cloud.viewpoint = unit.pose.translation();
   return out;
 }
 

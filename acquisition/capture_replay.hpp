@@ -9,6 +9,8 @@
 
 #include "acquisition/capture.hpp"
 #include "acquisition/scan_data.hpp"
+#include "acquisition/unit_config.hpp"
+#include "analysis/cloud.hpp"
 #include "analysis/progress.hpp"
 
 namespace sailshape {
@@ -31,6 +33,20 @@ struct ReplayResult {
 // Reads and decodes `path` (either capture format). Throws FileError as readCapture does; bad frames are
 // counted, not thrown.
 ReplayResult replayCapture(const std::string& path, const Progress& progress = {});
+
+struct ReplayCloud {
+  Cloud cloud;            // unit's pose applied: boat/scene frame; alpha_rad, beta_rad, intensity (RSSI1) filled
+  size_t scans_used = 0;  // frames with DIST1 and an encoder block
+  size_t beams = 0;       // beams in those frames, echoes or not
+  std::vector<std::string> warnings;
+};
+
+// The frames of `replay` as a cloud by SPEC §2 with the unit's p and θ, then its pose. β comes from each
+// frame's encoder block (turntable counts, acquisition/turntable_protocol.hpp), advancing linearly over the
+// mirror turn towards the next frame's reading; a DIST1 value of 0 (no echo) gives no point. A scanner
+// capture holds no turntable positions, so frames without an encoder block are skipped with a warning.
+// Throws InvalidInput when no frame has both DIST1 and an encoder block.
+ReplayCloud replayToCloud(const ReplayResult& replay, const UnitConfig& unit);
 
 // One frame: every field of ScanData (angles in 1/10000 degree and Hz fields as sent, plus *_hz and *_deg).
 nlohmann::json scanDataJson(const ScanData& scan);

@@ -4,6 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "acquisition/capture_replay.hpp"
+#include "acquisition/unit_config.hpp"
+#include "analysis/cloud_io.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"
 #include "cli/progress_bar.hpp"
@@ -14,6 +16,8 @@ namespace {
 struct ReplayOptions {
   std::string capture;
   std::string json;
+  std::string unit;
+  std::string cloud;
   bool quiet = false;
 };
 
@@ -47,6 +51,14 @@ void run(const ReplayOptions& o) {
     writeJsonFile(o.json, replayJson(r));
     std::fprintf(stderr, "wrote %s\n", o.json.c_str());
   }
+  if (!o.cloud.empty()) {
+    const UnitConfig unit = readUnitFile(o.unit);
+    const ReplayCloud c = replayToCloud(r, unit);
+    for (const std::string& w : c.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    writeCloud(o.cloud, c.cloud);
+    std::fprintf(stderr, "wrote %s: %zu points from %zu scans (%zu beams) of unit %s\n", o.cloud.c_str(),
+                 c.cloud.size(), c.scans_used, c.beams, unit.name.c_str());
+  }
 }
 
 }  // namespace
@@ -56,11 +68,20 @@ void addReplayCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "replay",
       "Decode an archived scanner session again: a sailshape capture (.sscap, written during scans) or a "
-      "pcapng-JSON recording of SICK CoLa traffic. Prints a summary; --json writes every LMDscandata frame.");
+      "pcapng-JSON recording of SICK CoLa traffic. Prints a summary; --json writes every LMDscandata frame; --unit "
+      "with --cloud turns the frames into a cloud with a new calibration.");
   cmd->add_option("capture", opt->capture, "Capture file (.sscap or pcapng-JSON)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--json", opt->json,
                   "Write per LMDscandata frame its counters, time stamps, frequencies, encoders, trailer blocks and "
                   "channels (name, scale, offset, start angle, step in 1/10000 deg, raw values as sent) to this JSON file");
+  CLI::Option* unit = cmd->add_option(
+      "--unit", opt->unit,
+      "Unit file (UNIT.json: p, θ, pose) to turn the frames into a cloud with; β comes from each frame's encoder "
+      "block (a scanner capture holds no turntable positions)")->check(CLI::ExistingFile);
+  CLI::Option* cloud = cmd->add_option("--cloud", opt->cloud,
+                                       "Write the cloud (.ply, .pcd, .xyz, .csv) in the unit's pose frame; needs --unit");
+  cloud->needs(unit);
+  unit->needs(cloud);
   cmd->add_flag("--quiet", opt->quiet, "No progress bar");
   cmd->callback([opt] { run(*opt); });
 }

@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "acquisition/capture_replay.hpp"
+#include "acquisition/turntable_protocol.hpp"
 #include "analysis/errors.hpp"
 
 namespace sailshape {
@@ -133,6 +135,69 @@ TEST(CaptureReplay, RecordingFramesAndJson) {
   EXPECT_EQ(j["frames"][0]["channels16"][0]["count"], 541);
   EXPECT_EQ(j["frames"][0]["time"]["year"], 1970);
   EXPECT_THROW(replayCapture(kRecordings + "README.md"), FileError);
+}
+
+// Two frames of a unit whose turntable encoder is wired to the scanner: β = 10° then 12° (one scan apart).
+ReplayResult encoderFrames() {
+  ReplayResult r;
+  for (int k = 0; k < 2; ++k) {
+    ScanData s;
+    s.scan_counter = static_cast<uint16_t>(7 + k);
+    s.scan_frequency = 2500;
+    const double beta_deg = 10.0 + 2.0 * k;
+    s.encoders = {{static_cast<uint32_t>(std::lround(beta_deg / 360.0 * kTurntableCountsPerRev)), 0}};
+    // α = 0°, 6°, ..., 180°; echoes only at 0° and 180°.
+    std::vector<uint16_t> dist(31, 0), rssi(31, 0);
+    dist[0] = 2000;
+    dist[30] = 3000;
+    rssi[0] = 200;
+    rssi[30] = 100;
+    s.channels16 = {{"DIST1", 1.0f, 0.0f, 0, 60000, dist}};
+    s.channels8 = {{"RSSI1", 1.0f, 0.0f, 0, 60000, rssi}};
+    r.frames.push_back({static_cast<double>(k), s});
+  }
+  return r;
+}
+
+TEST(CaptureReplay, CloudFromEncoderFramesFollowsSpec2AndThePose) {
+  UnitConfig unit;
+  unit.p_m = 0.12;
+  unit.theta_rad = 0.3;
+  unit.pose = makePose(Vec3(1, 2, 3), 0, 0, M_PI / 2);
+  const ReplayCloud c = replayToCloud(encoderFrames(), unit);
+  EXPECT_EQ(c.scans_used, 2u);
+  EXPECT_EQ(c.beams, 62u);
+  ASSERT_EQ(c.cloud.size(), 4u);  // two echoes per frame
+  EXPECT_TRUE(c.warnings.empty());
+  const double deg = M_PI / 180.0;
+  // Expected by SPEC §2 written out: β moves 2° per turn, so the beam at α = 180° fires at β0 + 1°.
+  auto expected = [&](double r, double alpha_deg, double beta_deg) {
+    const double a = alpha_deg * deg, b = beta_deg * deg;
+    const Vec3 u(r * std::cos(a), r * std::sin(a) * std::cos(b) + 0.12 * std::cos(b + 0.3),
+                 r * std::sin(a) * std::sin(b) + 0.12 * std::sin(b + 0.3));
+    return Vec3(1 - u.y(), 2 + u.x(), 3 + u.z());  // yaw 90°: x -> y, y -> -x
+  };
+  const double tick = 360.0 / kTurntableCountsPerRev;  // encoder rounding
+  const std::vector<Vec3> want = {expected(2.0, 0, 10), expected(3.0, 180, 11), expected(2.0, 0, 12),
+                                  expected(3.0, 180, 13)};
+  for (size_t i = 0; i < 4; ++i)
+    EXPECT_LT((c.cloud.points[i] - want[i]).norm(), (3.0 + 0.12) * tick * deg) << i;  // (r + p) × one tick
+  EXPECT_NEAR(c.cloud.beta_rad[1], 11 * deg, tick * deg);
+  EXPECT_NEAR(c.cloud.alpha_rad[1], M_PI, 1e-12);
+  EXPECT_EQ(c.cloud.intensity[1], 100.0f);
+  EXPECT_EQ(*c.cloud.viewpoint, Vec3(1, 2, 3));
+
+  ReplayResult no_encoder = encoderFrames();
+  for (auto& f : no_encoder.frames) f.scan.encoders.clear();
+  EXPECT_THROW(replayToCloud(no_encoder, unit), InvalidInput);
+  ReplayResult mixed = encoderFrames();
+  mixed.frames[1].scan.encoders.clear();
+  const ReplayCloud half = replayToCloud(mixed, unit);
+  EXPECT_EQ(half.scans_used, 1u);
+  ASSERT_EQ(half.warnings.size(), 1u);
+  UnitConfig bad = unit;
+  bad.speed_deg_s = 0;
+  EXPECT_THROW(replayToCloud(encoderFrames(), bad), InvalidInput);
 }
 
 }  // namespace

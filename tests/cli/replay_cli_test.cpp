@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,9 @@
 
 #include "acquisition/capture.hpp"
 #include "acquisition/scan_data.hpp"
+#include "acquisition/turntable_protocol.hpp"
+#include "acquisition/unit_config.hpp"
+#include "analysis/cloud_io.hpp"
 #include "tests/cli/run_sailshape.hpp"
 
 namespace {
@@ -94,6 +98,38 @@ TEST_F(ReplayCli, OurCaptureCutShortIsReplayedUpToTheCut) {
   EXPECT_EQ(doc["frames"][1]["scan_counter"], 2);
   EXPECT_DOUBLE_EQ(doc["frames"][1]["time_s"].get<double>(), 102.0);
   EXPECT_EQ(doc["frames"][0]["channels16"][0]["values"], nlohmann::json({1000, 1001, 1002}));
+}
+
+TEST_F(ReplayCli, UnitFileTurnsEncoderFramesIntoACloud) {
+  const fs::path cap = dir_ / "sweep.sscap";
+  {
+    sailshape::CaptureWriter w(cap.string(), sailshape::ColaDialect::kBinary);
+    for (int k = 0; k < 3; ++k) {
+      sailshape::ScanData s;
+      s.scan_counter = static_cast<uint16_t>(k + 1);
+      s.encoders = {{static_cast<uint32_t>(30 * k * sailshape::kTurntableCountsPerRev / 360), 0}};  // β = 0, 30, 60°
+      s.channels16 = {{"DIST1", 1.0f, 0.0f, 900000, 10000, {2500}}};  // one beam at α = 90°, 2.5 m
+      w.append({sailshape::CaptureDirection::kFromDevice, 1.0 + k,
+                sailshape::frameCola(sailshape::ColaDialect::kBinary,
+                                     sailshape::encodeScanData(s, sailshape::ColaDialect::kBinary))});
+    }
+  }
+  sailshape::UnitConfig unit;
+  unit.name = "jib";
+  std::ofstream(dir_ / "unit.json") << sailshape::unitToJson(unit);
+  const fs::path out = dir_ / "cloud.xyz";
+  const Outcome r = run("replay " + cap.string() + " --quiet --unit " + (dir_ / "unit.json").string() + " --cloud " +
+                        out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const sailshape::Cloud cloud = sailshape::readCloud(out.string()).cloud;
+  ASSERT_EQ(cloud.size(), 3u);
+  // p = 0, identity pose: α = 90° puts the point at r (0, cos β, sin β) (SPEC §2).
+  for (int k = 0; k < 3; ++k) {
+    const double b = 30.0 * k * M_PI / 180.0;
+    EXPECT_LT((cloud.points[k] - sailshape::Vec3(0, 2.5 * std::cos(b), 2.5 * std::sin(b))).norm(), 1e-4) << k;
+  }
+  const Outcome alone = run("replay " + cap.string() + " --quiet --cloud " + out.string());
+  EXPECT_NE(alone.exit_code, 0);  // --cloud needs --unit
 }
 
 TEST_F(ReplayCli, BadInputIsOneLineError) {
