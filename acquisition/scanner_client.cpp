@@ -303,7 +303,14 @@ ScannerStartup ScannerClient::start() {
   }
   if (params_.set_scan_config) {
     ColaWriter w(d);
-    w.u32(params_.scan_frequency).i16(1).u32(params_.angular_resolution).i32(params_.start_angle).i32(params_.stop_angle);
+    if (d == ColaDialect::kAscii) {
+      // SICK documents this method in CoLa A with signed decimals: "+2500 +1 +1667 -50000 +1850000".
+      auto decimal = [](int64_t v) { return (v < 0 ? "-" : "+") + std::to_string(v < 0 ? -v : v); };
+      w.token(decimal(params_.scan_frequency)).token("+1").token(decimal(params_.angular_resolution));
+      w.token(decimal(params_.start_angle)).token(decimal(params_.stop_angle));
+    } else {
+      w.u32(params_.scan_frequency).i16(1).u32(params_.angular_resolution).i32(params_.start_angle).i32(params_.stop_angle);
+    }
     const ColaTelegram t = request("sMN", "mLMPsetscancfg", w.bytes());
     const uint8_t status = ColaReader(d, t.arguments, "mLMPsetscancfg").u8("status");
     static const char* reasons[] = {"no error", "frequency not supported", "resolution not supported",
@@ -314,10 +321,11 @@ ScannerStartup ScannerClient::start() {
                          (status < 5 ? reasons[status] : "error " + std::to_string(status)));
   }
   {
-    // Channel 1 (DIST1), remission, 8-bit RSSI, unit digits, no encoder, no position/name/comment,
-    // time as asked, every scan.
+    // Output channel bytes {1, 0} (DIST1), remission, 8-bit RSSI, unit digits, encoder bytes {0, 0}, no
+    // position/name/comment, time as asked, every scan. Two-byte fields are two tokens in CoLa A ("01 00").
     ColaWriter w(d);
-    w.u16(0x0100).u8(params_.rssi ? 1 : 0).u8(0).u8(0).u16(0).u8(0).u8(0).u8(0).u8(params_.time_block ? 1 : 0).u16(1);
+    w.u8(1).u8(0).u8(params_.rssi ? 1 : 0).u8(0).u8(0).u8(0).u8(0).u8(0).u8(0).u8(0);
+    w.u8(params_.time_block ? 1 : 0).u16(1);
     request("sWN", "LMDscandatacfg", w.bytes());
   }
   {

@@ -11,7 +11,8 @@
 //   sMN SetAccessMode 3 F4724744   -> sAN SetAccessMode 1            (0 = refused: ScannerError)
 //   sRN FirmwareVersion            -> sRA FirmwareVersion <string>
 //   sRN SCdevicestate              -> sRA SCdevicestate <u8>          (2 = error: ScannerError)
-//   sMN mLMPsetscancfg f 1 res start stop -> sAN mLMPsetscancfg 0 ...  (only with set_scan_config)
+//   sMN mLMPsetscancfg f 1 res start stop -> sAN mLMPsetscancfg 0 ...  (only with set_scan_config; CoLa A
+//                                  writes these as signed decimals, "+2500 +1 +1667 -50000 +1850000", as SICK documents)
 //   sWN LMDscandatacfg ...         -> sWA LMDscandatacfg
 //   sWN LMPoutputRange 1 res start stop -> sWA LMPoutputRange; sRN LMPoutputRange -> sRA (checked)
 //   sMN LMCstartmeas               -> sAN LMCstartmeas 0

@@ -156,7 +156,8 @@ RecordedDevice loadRecordedDevice(const std::string& file) {
 // `after_start` runs once streaming was enabled; when it returns true the script goes on answering (the stop
 // sequence), when false it hangs up at once.
 void answerStartup(PeerConnection& c, const RecordedDevice* recorded,
-                   const std::function<bool(PeerConnection&)>& after_start, bool stray_reply = false) {
+                   const std::function<bool(PeerConnection&)>& after_start, bool stray_reply = false,
+                   const std::string& before_stream_reply = {}) {
   const ColaDialect d = c.dialect();
   std::string output_range_args;
   while (auto p = c.nextRequest()) {
@@ -170,6 +171,7 @@ void answerStartup(PeerConnection& c, const RecordedDevice* recorded,
       continue;
     }
     if (t.type == "sEN" && t.name == "LMDscandata") {
+      if (!before_stream_reply.empty()) c.send(before_stream_reply);
       c.send(colaPayload("sEA", t.name, t.arguments));
       ColaReader r(d, t.arguments, "test");
       if (r.u8("on") == 1 && !after_start(c)) return;
@@ -231,40 +233,53 @@ std::string tempPath(const std::string& name) {
   return path.string();
 }
 
-TEST(ScannerClient, StartupSequenceAgainstRecordedLms511Replies) {
-  const RecordedDevice lms511 = loadRecordedDevice("20210302_lms511.pcapng.json");
-  ASSERT_GE(lms511.scans.size(), 5u);
+// What a recorded device is expected to tell the client.
+struct RecordedCase {
+  const char* file;
+  ScannerClientParams params;  // port and capture path are filled in by the test
+  const char* firmware;
+  uint16_t first_scan_counter;      // README fact
+  uint32_t resolution;              // LMPoutputRange as the device reads it back
+  int32_t start, stop;
+  bool same_output_range_request;   // our sWN LMPoutputRange equals the driver's byte for byte
+};
+
+void runRecordedStartup(const RecordedCase& rc) {
+  const RecordedDevice dev = loadRecordedDevice(rc.file);
+  ASSERT_GE(dev.scans.size(), 5u);
   ScriptedPeer peer(ColaDialect::kBinary, [&](PeerConnection& c, int) {
     answerStartup(
-        c, &lms511,
+        c, &dev,
         [&](PeerConnection& conn) {
           for (size_t i = 0; i < 5; ++i) {
             conn.send("sSN LIDoutputstate " + bytes({0, 0, 0, 1}));
-            conn.send(lms511.scans[i]);
+            conn.send(dev.scans[i]);
           }
           return true;
         },
         true);
   });
   const std::string capture = tempPath("startup.sscap");
-  ScannerClientParams p = paramsFor(peer.port());
+  ScannerClientParams p = rc.params;
+  p.port = peer.port();
   p.capture_path = capture;
   {
     ScannerClient client(p);
     const ScannerStartup s = client.start();
-    EXPECT_EQ(s.firmware_version, "V1.80    ");  // as the LMS511 sends it, padded
-    EXPECT_EQ(s.device_state, 0);                // the recorded device said "busy" while starting
-    EXPECT_EQ(s.output_resolution, 1667u);
-    EXPECT_EQ(s.output_start, -50000);
-    EXPECT_EQ(s.output_stop, 1850000);
-    EXPECT_TRUE(s.warnings.empty());
+    EXPECT_EQ(s.firmware_version, rc.firmware);  // as the device sends it, padded
+    EXPECT_EQ(s.device_state, 0);                 // both recorded devices said "busy" while starting
+    EXPECT_EQ(s.output_resolution, rc.resolution);
+    EXPECT_EQ(s.output_start, rc.start);
+    EXPECT_EQ(s.output_stop, rc.stop);
+    // A read-back that differs from what was written is reported, not hidden.
+    EXPECT_EQ(s.warnings.empty(), rc.same_output_range_request);
     const ScanBatch b = client.receiveScans(5, 20.0);
     ASSERT_EQ(b.scans.size(), 5u);
     EXPECT_FALSE(b.connection_lost);
     EXPECT_FALSE(b.timed_out);
     for (size_t i = 0; i < 5; ++i)
-      EXPECT_EQ(b.scans[i].scan_counter, decodeScanData(lms511.scans[i], ColaDialect::kBinary).scan_counter);
-    EXPECT_EQ(b.scans[0].scan_counter, 54484);  // README fact
+      EXPECT_EQ(b.scans[i].scan_counter, decodeScanData(dev.scans[i], ColaDialect::kBinary).scan_counter);
+    EXPECT_EQ(b.scans[0].scan_counter, rc.first_scan_counter);
     EXPECT_EQ(client.stats().other_events, 5u);  // LIDoutputstate events ignored
     EXPECT_EQ(client.stats().bad_checksum, 0u);
     EXPECT_EQ(client.stats().stray_replies, 1u);
@@ -282,11 +297,20 @@ TEST(ScannerClient, StartupSequenceAgainstRecordedLms511Replies) {
       "sMN SetAccessMode", "sRN FirmwareVersion", "sRN SCdevicestate", "sMN mLMPsetscancfg",
       "sWN LMDscandatacfg", "sWN LMPoutputRange", "sRN LMPoutputRange", "sMN LMCstartmeas",
       "sMN Run", "sEN LMDscandata", "sEN LMDscandata", "sMN LMCstopmeas"};
-  EXPECT_EQ(names, expected);
-  // Login and output range are byte for byte what SICK's driver sent the LMS511.
-  EXPECT_EQ(splitColaTelegram(requests[0][0]).arguments, lms511.request_args.at("sMN SetAccessMode"));
-  EXPECT_EQ(splitColaTelegram(requests[0][5]).arguments, lms511.request_args.at("sWN LMPoutputRange"));
-  EXPECT_EQ(splitColaTelegram(requests[0][4]).arguments.size(), lms511.request_args.at("sWN LMDscandatacfg").size());
+  ASSERT_EQ(names, expected);
+  // Login and data configuration are byte for byte what SICK's driver sent the device.
+  EXPECT_EQ(splitColaTelegram(requests[0][0]).arguments, dev.request_args.at("sMN SetAccessMode"));
+  EXPECT_EQ(splitColaTelegram(requests[0][4]).arguments, dev.request_args.at("sWN LMDscandatacfg"));
+  EXPECT_EQ(splitColaTelegram(requests[0][5]).arguments == dev.request_args.at("sWN LMPoutputRange"),
+            rc.same_output_range_request);
+  // Every request the client sends is one the recorded device answered with the type the client checks
+  // (mLMPsetscancfg and LMCstopmeas are not in the recordings).
+  for (const std::string& name : names) {
+    if (name == "sMN mLMPsetscancfg" || name == "sMN LMCstopmeas") continue;
+    ASSERT_TRUE(dev.replies.count(name)) << name;
+    const ColaTelegram reply = splitColaTelegram(dev.replies.at(name));
+    EXPECT_EQ(reply.type, colaReplyType(name.substr(0, 3))) << name;
+  }
 
   // The archive holds every byte both ways: the same five scans decode from it.
   const CaptureTelegrams archived = extractTelegrams(readCapture(capture));
@@ -294,6 +318,24 @@ TEST(ScannerClient, StartupSequenceAgainstRecordedLms511Replies) {
   for (const auto& t : archived.telegrams) scans += isScanDataTelegram(t.payload) ? 1 : 0;
   EXPECT_EQ(scans, 5u);
   std::filesystem::remove(capture);
+}
+
+TEST(ScannerClient, StartupSequenceAgainstRecordedLms511Replies) {
+  ScannerClientParams p = paramsFor(0);
+  p.time_block = true;  // as SICK's driver configured it
+  runRecordedStartup({"20210302_lms511.pcapng.json", p, "V1.80    ", 54484, 1667, -50000, 1850000, true});
+}
+
+TEST(ScannerClient, StartupSequenceAgainstRecordedLms111Replies) {
+  ScannerClientParams p = paramsFor(0);
+  p.scan_frequency = 5000;
+  p.angular_resolution = 5000;
+  p.start_angle = -450000;
+  p.stop_angle = 2250000;
+  p.rssi = false;  // the recorded LMS111 sent DIST1 only
+  p.time_block = true;
+  // SICK's driver wrote -449997..2249997 and the device reads that back: ours differs, so a warning.
+  runRecordedStartup({"20210302_lms111.pcapng.json", p, "V1.80.2  ", 4, 5000, -449997, 2249997, false});
 }
 
 TEST(ScannerClient, AsciiDialectStartupStreamAndPoll) {
@@ -442,10 +484,10 @@ TEST(ScannerClient, GarbageAndBadChecksumInTheStreamAreDroppedAndCounted) {
 
 TEST(ScannerClient, NoScanWithinTheTimeoutIsReported) {
   ScriptedPeer peer(ColaDialect::kBinary, [](PeerConnection& c, int) {
-    answerStartup(c, nullptr, [](PeerConnection& conn) {
-      conn.send(encodeScanData(syntheticScan(1), ColaDialect::kBinary));
-      return true;
-    });
+    // One scan only, sent before the reply that enables streaming: the client holds it before it waits.
+    answerStartup(
+        c, nullptr, [](PeerConnection&) { return true; }, false,
+        encodeScanData(syntheticScan(1), ColaDialect::kBinary));
   });
   ScannerClientParams p = paramsFor(peer.port());
   p.scan_timeout_s = 0.3;
