@@ -167,7 +167,8 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     const double period_s = s.scan_frequency > 0 ? 100.0 / s.scan_frequency : 1.0 / unit.frequency_hz;
     const double scan_host_start = s.time_since_startup_us * 1e-6 + clock_offset;
     if (scan_host_start < sweep.start_time_s - period_s) continue;
-    double beta0 = 0, beta_rate = 0;  // degrees at the first beam, degrees per period
+    // β(u) = beta0 + beta_rate·u + beta_curve·u², u in scan periods from this scan's first beam.
+    double beta0 = 0, beta_rate = 0, beta_curve = 0;
     if (encoder) {
       if (s.encoders.empty()) {
         sweep.warnings.push_back("scan " + std::to_string(s.scan_counter) +
@@ -175,13 +176,22 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
         continue;
       }
       beta0 = encoderDeg(s);
-      // Per-beam β: the encoder advances linearly to the next scan's reading, one period per scan counter step.
-      const ScanData* next = k + 1 < scans.size() ? &scans[k + 1].data : nullptr;
-      const ScanData* prev = k > 0 ? &scans[k - 1].data : nullptr;
-      if (next && !next->encoders.empty() && next->scan_counter != s.scan_counter)
-        beta_rate = (encoderDeg(*next) - beta0) / static_cast<uint16_t>(next->scan_counter - s.scan_counter);
-      else if (prev && !prev->encoders.empty() && prev->scan_counter != s.scan_counter)
-        beta_rate = (beta0 - encoderDeg(*prev)) / static_cast<uint16_t>(s.scan_counter - prev->scan_counter);
+      // The encoder is latched once per scan; between readings the turntable may accelerate, so β per beam
+      // follows the parabola through the previous, this and the next reading (a line at the ends).
+      const auto usable = [&](size_t j) { return j < scans.size() && !scans[j].data.encoders.empty(); };
+      const double h_next = usable(k + 1) ? static_cast<uint16_t>(scans[k + 1].data.scan_counter - s.scan_counter) : 0;
+      const double h_prev = k > 0 && usable(k - 1) ? static_cast<uint16_t>(s.scan_counter - scans[k - 1].data.scan_counter) : 0;
+      const double d_next = h_next > 0 ? encoderDeg(scans[k + 1].data) - beta0 : 0;
+      const double d_prev = h_prev > 0 ? beta0 - encoderDeg(scans[k - 1].data) : 0;
+      if (h_next > 0 && h_prev > 0) {
+        const double s_next = d_next / h_next, s_prev = d_prev / h_prev;
+        beta_curve = (s_next - s_prev) / (h_next + h_prev);
+        beta_rate = s_next - beta_curve * h_next;
+      } else if (h_next > 0) {
+        beta_rate = d_next / h_next;
+      } else if (h_prev > 0) {
+        beta_rate = d_prev / h_prev;
+      }
     }
     ++used;
     sweep.beams += dist->values.size();
@@ -193,7 +203,8 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
       p.alpha_rad = scanAngleRad(*dist, i);
       const double frac = (scanAngleDeg(*dist, i) - first_alpha_deg) / 360.0;
       p.time_s = scan_host_start + frac * period_s;
-      const double beta_deg = encoder ? beta0 + frac * beta_rate : interpolateBeta(table_samples, p.time_s);
+      const double beta_deg =
+          encoder ? beta0 + frac * (beta_rate + frac * beta_curve) : interpolateBeta(table_samples, p.time_s);
       p.beta_rad = beta_deg * kDeg;
       if (rssi && i < rssi->values.size()) p.rssi = static_cast<uint8_t>(std::min<uint16_t>(rssi->values[i], 255));
       sweep.points.push_back(p);

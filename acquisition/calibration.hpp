@@ -1,0 +1,62 @@
+#pragma once
+// The unit's geometric constants p and θ (SPEC §2) by least squares: choose
+// them so that sweeps of known shapes — planes of unknown position, cylinders
+// of known radius — fit best (the study's procedure, chapter 4). Each target
+// brings its own nuisance parameters (plane normal and offset; cylinder axis);
+// p and θ are shared. Gauss–Newton with Levenberg damping, then one refit
+// without residuals beyond a robust cut (mixed pixels, stray returns) and
+// without samples at steep incidence.
+//
+// Conditioning: a single plane seen over a narrow β range cannot separate θ
+// from the plane's tilt; two planes at an angle (a wall and the floor) or a
+// cylinder, seen over a wide β range, can. The result reports standard errors
+// so a poor set-up shows.
+#include <string>
+#include <vector>
+
+#include "acquisition/sweep.hpp"
+
+namespace sailshape {
+
+struct CalibrationTarget {
+  enum class Kind { Plane, Cylinder } kind = Kind::Plane;
+  double radius_m = 0;              // cylinders: known radius
+  std::vector<SweepPoint> samples;  // r, α, β of the target's points only
+  std::string name;
+};
+
+struct CalibrationParams {
+  double initial_p_m = 0.05;        // must be > 0: θ has no effect at p = 0
+  double initial_theta_rad = 0.0;
+  int max_iterations = 100;
+  double outlier_sigmas = 4.0;      // refit without |residual| > this × robust σ (0: keep all)
+  // The refit also drops samples seen at more than this incidence: SPEC §3's noise is flat only up to ≈ 70°,
+  // and the steep samples would otherwise weigh as much as the good ones.
+  double max_incidence_deg = 65.0;
+};
+
+struct CalibrationTargetResult {
+  std::string name;
+  size_t points = 0, outliers = 0;
+  double rms_m = 0;                 // residual RMS after the fit (outliers excluded)
+  double max_abs_m = 0;
+  // The fitted shape (unit frame): plane n·x = d, or cylinder axis through `point` along `normal`.
+  Vec3 normal = Vec3::Zero(), point = Vec3::Zero();
+  double offset_m = 0;
+};
+
+struct CalibrationResult {
+  double p_m = 0, theta_rad = 0;
+  double p_stderr_m = 0, theta_stderr_rad = 0;  // from the normal equations and the residual variance
+  double rms_m = 0;                             // over all targets
+  int iterations = 0;
+  bool converged = false;
+  std::vector<CalibrationTargetResult> targets;
+  std::vector<std::string> warnings;
+};
+
+// Throws InvalidInput: no target, a target with fewer than 10 samples, a cylinder without a positive
+// radius, initial_p_m ≤ 0.
+CalibrationResult calibrateUnit(const std::vector<CalibrationTarget>& targets, const CalibrationParams& params = {});
+
+}  // namespace sailshape
