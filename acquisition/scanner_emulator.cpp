@@ -346,7 +346,7 @@ std::string ScannerEmulator::reply(const std::string& request, bool binary) {
     if (t.name == "LMPscancfg") return out("sRA", w.u32(s.frequency).u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
     if (t.name == "LMDscandatacfg") {
       if (!s.scandatacfg_args.empty()) return colaPayload("sRA", t.name, s.scandatacfg_args);
-      return out("sRA", w.u8(1).u8(0).u8(s.remission).u8(0).u8(0).u16(s.encoder ? 0x0100 : 0).u8(0).u8(0).u8(0)
+      return out("sRA", w.u8(1).u8(0).u8(s.remission).u8(0).u8(0).u8(s.encoder ? 1 : 0).u8(0).u8(0).u8(0).u8(0)
                             .u8(s.time_block).u16(1));
     }
     if (t.name == "LIDinputstate") {
@@ -385,11 +385,14 @@ std::string ScannerEmulator::reply(const std::string& request, bool binary) {
       return bare("sWA");
     }
     if (t.name == "LMDscandatacfg") {
-      const uint16_t channel = in.u16("output channel");
+      // Two-byte fields go as byte pairs ("1 0" in CoLa A), as SICK's driver writes them.
+      const uint8_t channel = in.u8("output channel");
+      in.u8("output channel (second byte)");
       const uint8_t remission = in.u8("remission");
       const uint8_t resolution = in.u8("remission resolution");
       in.u8("unit");
-      const uint16_t encoder = in.u16("encoder");
+      const uint8_t encoder = in.u8("encoder");
+      in.u8("encoder (second byte)");
       in.u8("position");
       in.u8("device name");
       in.u8("comment");

@@ -86,7 +86,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     // The turntable's encoder is wired to the scanner: ask for the encoder block in every scan
     // (LMDscandatacfg: channel, remission, 8-bit, mm, encoder 1, no position/name/comment/time, every scan).
     ColaWriter w(sp.dialect);
-    w.u16(0x0100).u8(unit.rssi ? 1 : 0).u8(0).u8(0).u16(0x0100).u8(0).u8(0).u8(0).u8(0).u16(1);
+    w.u8(1).u8(0).u8(unit.rssi ? 1 : 0).u8(0).u8(0).u8(1).u8(0).u8(0).u8(0).u8(0).u8(0).u16(1);
     scanner.request("sWN", "LMDscandatacfg", w.bytes());
   }
 

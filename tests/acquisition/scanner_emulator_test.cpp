@@ -160,7 +160,7 @@ TEST(ScannerEmulator, StreamsRayCastRangesAtTheConfiguredRate) {
   // 50 Hz, 1°, 60°..120°: 61 values.
   const ColaTelegram cfg = ask("sMN", "mLMPsetscancfg", W(ColaDialect::kBinary).u32(5000).u16(1).u32(10000).i32(600000).i32(1200000));
   EXPECT_EQ(cfg.arguments[0], '\x00') << "status: no error";
-  ask("sWN", "LMDscandatacfg", W(ColaDialect::kBinary).u16(0x0100).u8(1).u8(0).u8(0).u16(0).u8(0).u8(0).u8(0).u8(0).u16(1));
+  ask("sWN", "LMDscandatacfg", W(ColaDialect::kBinary).u8(1).u8(0).u8(1).u8(0).u8(0).u8(0).u8(0).u8(0).u8(0).u8(0).u8(0).u16(1));
   EXPECT_EQ(ask("sMN", "LMCstartmeas", W(ColaDialect::kBinary)).type, "sAN");
   EXPECT_EQ(ask("sMN", "Run", W(ColaDialect::kBinary)).type, "sAN");
   EXPECT_EQ(ask("sEN", "LMDscandata", W(ColaDialect::kBinary).u8(1)).type, "sEA");

@@ -90,9 +90,10 @@ PlaneFit fitPlane(const std::vector<Vec3>& pts) {
   return f;
 }
 
-void checkPlaneSweep(BetaSource source) {
+void checkPlaneSweep(BetaSource source, const std::string& protocol = "cola-b") {
   UnitConfig u = compactUnit(0.12, 25);
   u.beta_source = source;
+  u.protocol = protocol;
   u.pose = makePose(Vec3(0.5, -1.0, 2.0), 0, 0, 0.3);
   // The wall y = 3 in the unit frame, placed in the scene through the pose.
   Scene scene;
@@ -128,6 +129,8 @@ void checkPlaneSweep(BetaSource source) {
 TEST(Sweep, PlaneWithEncoderBeta) { checkPlaneSweep(BetaSource::Encoder); }
 
 TEST(Sweep, PlaneWithTimestampBeta) { checkPlaneSweep(BetaSource::Timestamp); }
+
+TEST(Sweep, PlaneInColaA) { checkPlaneSweep(BetaSource::Encoder, "cola-a"); }
 
 TEST(Sweep, CylinderAtAKnownPosition) {
   // A vertical cylinder of radius 0.4 m, axis through (0.3, 3, ·) in the unit frame; no background.
