@@ -11,5 +11,6 @@ void addDesignCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addDbCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
+void addReportCommand(CLI::App& app);
 
 }  // namespace sailshape::cli

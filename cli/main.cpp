@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   sailshape::cli::addCompareCommand(app);
   sailshape::cli::addDbCommand(app);
   sailshape::cli::addReplayCommand(app);
+  sailshape::cli::addReportCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

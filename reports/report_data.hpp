@@ -1,0 +1,55 @@
+#pragma once
+// What a trim report shows, read from the database: the sail and where it
+// flew, and per trim step its conditions, forces, controls and sections.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/cloud.hpp"
+#include "analysis/mesh.hpp"
+#include "analysis/sections.hpp"
+#include "database/sqlite.hpp"
+
+namespace sailshape {
+
+// One stored section. A value the analysis could not measure (NULL in the
+// file) is NaN here, in `value` and in `uncertainty` (1σ, same units).
+struct ReportSection {
+  double fraction = 0;
+  SectionParameters value, uncertainty;
+  bool converged = true;
+  std::vector<Vec3> curve;  // metres, boat frame, luff to leech
+};
+
+struct ReportStep {
+  int64_t scan_id = 0, trim_step_id = 0, analysis_id = 0;
+  int step_order = 0;
+  std::string scanned_at;  // ISO 8601, empty when unknown
+  std::optional<double> awa_deg, aws_m_s, drive_n, side_n, heel_moment_nm;
+  std::map<std::string, double> controls;  // control-line settings as stored
+  std::vector<ReportSection> sections;     // the latest analysis, by fraction
+  Cloud cloud;                             // the stored cloud; empty when none was stored
+};
+
+struct ReportData {
+  std::string campaign, campaign_kind, place, campaign_start, session, session_started;
+  std::string boat, boat_class;
+  std::string sail, sail_type, size_variant, designer, version;
+  std::string test;                        // empty for a single scan without a test
+  std::optional<Mesh> design_mesh;         // the sail's stored design, when there is one
+  std::vector<ReportStep> steps;           // one per trim step, in step order
+};
+
+// The scan `scan_id` with its trim step, sail and latest analysis. Throws
+// InvalidInput for an unknown scan or a scan without an analysis.
+ReportData loadScanReport(Database& db, int64_t scan_id);
+
+// Every trim step of test `test` (by name), each with its latest analysed
+// scan. `sail` picks the sail when the test name is used for more than one;
+// empty: the test must belong to one sail. Throws InvalidInput for an unknown
+// test, an ambiguous one, or a test without analysed scans.
+ReportData loadTestReport(Database& db, const std::string& test, const std::string& sail = "");
+
+}  // namespace sailshape

@@ -1,0 +1,522 @@
+// The PDF trim report built from a database with known values, read back with
+// poppler's pdftotext / pdfinfo / pdftoppm.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <regex>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "analysis/errors.hpp"
+#include "analysis/sail_generator.hpp"
+#include "database/catalog.hpp"
+#include "database/import.hpp"
+#include "database/schema.hpp"
+#include "reports/pdf_document.hpp"
+#include "reports/private_display.hpp"
+#include "reports/render_views.hpp"
+#include "reports/report_summary.hpp"
+#include "reports/trim_report.hpp"
+#include "tests/cli/run_sailshape.hpp"
+#include "tests/database/db_fixture.hpp"
+
+namespace sailshape {
+namespace {
+
+using test::TempDir;
+
+// CI has no display: every render here goes through the report's own Xvfb.
+class NoDisplay : public ::testing::Environment {
+ public:
+  void SetUp() override { unsetenv("DISPLAY"); }
+};
+const auto* const kNoDisplay = ::testing::AddGlobalTestEnvironment(new NoDisplay);
+
+constexpr int kSteps = 3, kSections = 8;
+const char* const kSail = "Grand-voile Été";
+const char* const kBoat = "Øresund Flyer";
+const char* const kCampaign = "Régates de Côte Bleue";
+const char* const kTest = "twist sweep";
+
+// Step k's flying shape: the design with its sheet eased, twist opened by
+// 1.5°·k over the whole height plus 1.5°·k more at the head, and 0.5 % deeper per step.
+SailDesign flyingDesign(const SailDesign& design, int k) {
+  SailDesign d = design;
+  for (auto& s : d.stations) {
+    s.twist_deg += 1.5 * k * (1 + s.fraction);
+    s.camber_pct += 0.5 * k;
+  }
+  return d;
+}
+
+double round2(double v) { return std::round(v * 100) / 100; }
+double round1(double v) { return std::round(v * 10) / 10; }
+
+// A flying section of step k at fraction f: the generator's known parameters,
+// rounded as the report prints them, so the PDF must show exactly these.
+nlohmann::json flyingSection(const SailSurface& surface, double f, int k) {
+  const KnownSection known = surface.section(f);
+  nlohmann::json s = {{"fraction", f},
+                      {"chord_m", round2(known.chord_m)},
+                      {"camber_pct", round2(known.camber_pct)},
+                      {"draft_pct", round1(known.draft_pct)},
+                      {"twist_deg", round1(known.twist_deg)},
+                      {"twist_rel_deg", 0.0},
+                      {"entry_deg", round1(known.entry_deg)},
+                      {"exit_deg", round1(known.exit_deg)},
+                      {"plane_tilt_deg", 0.0},
+                      {"converged", true}};
+  // SPEC §3: σ ≈ 4 mm on chords of 2–4 m gives ≈ 0.1–0.2 % camber, ≈ 0.1° twist.
+  s["uncertainty"] = {{"chord_m", 0.006},     {"camber_pct", 0.13 + 0.01 * k}, {"draft_pct", 0.9},
+                      {"twist_deg", 0.2},     {"twist_rel_deg", 0.3},          {"entry_deg", 1.1},
+                      {"exit_deg", 1.3}};
+  nlohmann::json curve = nlohmann::json::array();
+  for (int i = 0; i <= 40; ++i) {
+    const Vec3 p = surface.at(f, i / 40.0);
+    curve.push_back({p.x(), p.y(), p.z()});
+  }
+  s["curve"] = curve;
+  return s;
+}
+
+struct Fixture {
+  TempDir dir;
+  std::string db_path = dir.file("trim.sailshape");
+  SailDesign design = exampleDesign(SailType::Main);
+  std::vector<int64_t> scan_ids;
+  std::vector<nlohmann::json> docs;
+
+  Fixture() {
+    Database db = openSailDatabase(db_path);
+    const Mesh mesh = generateSailMesh(design);
+    upsertSail(db, {kSail, "mainsail", "M", "Voilerie Lætitia", "v3", kBoat}, &mesh);
+    for (int k = 0; k < kSteps; ++k) {
+      const SailSurface surface(flyingDesign(design, k));
+      nlohmann::json doc;
+      doc["sections"] = nlohmann::json::array();
+      for (int i = 1; i <= kSections; ++i) doc["sections"].push_back(flyingSection(surface, i / 9.0, k));
+      ImportMetadata meta;
+      meta.campaign = kCampaign;
+      meta.session = "day 1";
+      meta.sail = kSail;
+      meta.boat = kBoat;
+      meta.test = kTest;
+      meta.trim_step = k + 1;
+      meta.awa_deg = 26.0 + 2 * k;
+      meta.aws_m_s = 6.5;
+      meta.drive_n = 410.0 + 25 * k;
+      meta.side_n = 980.0 - 40 * k;
+      meta.heel_moment_nm = 2600.0 - 90 * k;
+      meta.controls = {{"sheet", 1.25 - 0.05 * k}, {"traveller", 0.1 * k}};
+      meta.scanned_at = "2026-06-1" + std::to_string(k) + "T10:30:00Z";
+      scan_ids.push_back(importScan(db, meta, &doc).scan_id);
+      docs.push_back(doc);
+    }
+  }
+
+  TrimReportParams params(const std::string& out) const {
+    TrimReportParams p;
+    p.db_path = db_path;
+    p.test = kTest;
+    p.out_path = dir.file(out);
+    return p;
+  }
+};
+
+// One fixture for the suite: the database is read-only to every test.
+Fixture& fixture() {
+  static Fixture f;
+  return f;
+}
+
+std::string run(const std::string& cmd) {
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) out.append(buf, n);
+  pclose(p);
+  return out;
+}
+
+std::string pdfText(const std::string& pdf) { return run("pdftotext -layout '" + pdf + "' - 2>/dev/null"); }
+
+int pdfPages(const std::string& pdf) {
+  std::istringstream info(run("pdfinfo '" + pdf + "' 2>/dev/null"));
+  std::string line;
+  while (std::getline(info, line))
+    if (line.rfind("Pages:", 0) == 0) return std::stoi(line.substr(6));
+  return -1;
+}
+
+struct Raster {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;
+};
+
+// Page `page` rasterised at `dpi` (pdftoppm writes binary PPM).
+Raster pageRaster(const std::string& pdf, int page, int dpi) {
+  const std::string prefix = pdf + ".page";
+  run("pdftoppm -r " + std::to_string(dpi) + " -f " + std::to_string(page) + " -l " + std::to_string(page) +
+      " -singlefile '" + pdf + "' '" + prefix + "'");
+  std::ifstream in(prefix + ".ppm", std::ios::binary);
+  Raster r;
+  std::string magic;
+  int maxval = 0;
+  in >> magic >> r.width >> r.height >> maxval;
+  in.get();
+  if (magic != "P6" || maxval != 255) return {};
+  r.rgb.resize(size_t(r.width) * r.height * 3);
+  in.read(reinterpret_cast<char*>(r.rgb.data()), static_cast<std::streamsize>(r.rgb.size()));
+  return r;
+}
+
+struct Colours {
+  size_t pixels = 0, ink = 0, blue = 0, red = 0;
+};
+
+// Pixels in the page rectangle (points from the top-left) that are not white,
+// design blue (blue channel well above red and green) or flying red.
+Colours countColours(const Raster& r, int dpi, float x, float y, float w, float h) {
+  Colours c;
+  const double s = dpi / 72.0;
+  for (int py = int(y * s); py < int((y + h) * s) && py < r.height; ++py)
+    for (int px = int(x * s); px < int((x + w) * s) && px < r.width; ++px) {
+      const unsigned char* p = &r.rgb[(size_t(py) * r.width + px) * 3];
+      ++c.pixels;
+      if (p[0] < 235 || p[1] < 235 || p[2] < 235) ++c.ink;
+      if (p[2] > 120 && p[2] > p[0] + 60 && p[2] > p[1] + 40) ++c.blue;
+      if (p[0] > 90 && p[0] > p[1] + 50 && p[0] > p[2] + 50) ++c.red;
+    }
+  return c;
+}
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), f, v);
+  return buf;
+}
+
+TEST(TrimReport, DesignIsAnalysedAtTheFlyingFractions) {
+  TrimReportParams p = fixture().params("unused.pdf");
+  const TrimReportData r = prepareTrimReport(p);
+  ASSERT_EQ(r.data.steps.size(), size_t(kSteps));
+  ASSERT_EQ(r.design_sections.sections.size(), size_t(kSections));
+  const SailSurface design(fixture().design);
+  // Clean-data tolerances of the analysis core (tests/analysis/design_compare_test.cpp).
+  for (const Section& s : r.design_sections.sections) {
+    SCOPED_TRACE("fraction " + std::to_string(s.fraction));
+    const KnownSection k = design.section(s.fraction);
+    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, 0.1);
+    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, 1.0);
+    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, 0.1);
+    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, 1.0);
+    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, 1.0);
+  }
+  // Step 3 is 3° + 3°·f more twisted and 1 % deeper than the design everywhere.
+  for (const ComparedSection& c : r.steps.back().sections) {
+    EXPECT_NEAR(c.flying.twist_deg - c.design.twist_deg, 3.0 * (1 + c.fraction), 0.2);
+    EXPECT_NEAR(c.flying.camber_pct - c.design.camber_pct, 1.0, 0.15);
+  }
+  // The first step flies the design itself: its lofted surface is on the design
+  // within the loft's chordwise interpolation (a few mm on 1.1 m between sections).
+  EXPECT_LT(std::abs(r.steps.front().deviation.mean_m), 0.005);
+  EXPECT_LT(r.steps.front().deviation.max_abs_m, 0.02);
+  EXPECT_GT(r.steps.back().deviation.max_abs_m, 0.05);  // 6° more twist at the head moves the leech by decimetres
+  ASSERT_FALSE(r.summary.sentences.empty());
+  EXPECT_NE(r.summary.sentences.front().find("The head section"), std::string::npos) << r.summary.sentences.front();
+  EXPECT_NE(r.summary.sentences.front().find("more twisted than designed"), std::string::npos);
+}
+
+TEST(TrimReport, DesignerReportShowsTheDatabaseNumbersAndBothColours) {
+  const TrimReportParams p = fixture().params("designer.pdf");
+  const TrimReport report = writeTrimReport(p);
+  EXPECT_TRUE(report.private_display);
+  // Cover, 3 × (3D page, section table), plots, section curves, step changes.
+  EXPECT_EQ(report.pages, 1 + 2 * kSteps + 3);
+  EXPECT_EQ(pdfPages(p.out_path), report.pages);
+
+  const std::string text = pdfText(p.out_path);
+  EXPECT_NE(text.find(kSail), std::string::npos);
+  EXPECT_NE(text.find(kBoat), std::string::npos);
+  EXPECT_NE(text.find(kCampaign), std::string::npos);
+  EXPECT_NE(text.find("Voilerie Lætitia"), std::string::npos);
+  for (int k = 0; k < kSteps; ++k)
+    for (const auto& s : fixture().docs[k]["sections"]) {
+      const double f = s["fraction"];
+      SCOPED_TRACE("step " + std::to_string(k + 1) + " fraction " + std::to_string(f));
+      const auto& u = s["uncertainty"];
+      EXPECT_NE(text.find(fmt("%.2f", s["camber_pct"].get<double>()) + " ± " + fmt("%.2f", u["camber_pct"].get<double>())),
+                std::string::npos);
+      EXPECT_NE(text.find(fmt("%.1f", s["draft_pct"].get<double>()) + " ± 0.9"), std::string::npos);
+      EXPECT_NE(text.find(fmt("%.1f", s["twist_deg"].get<double>()) + " ± 0.2"), std::string::npos);
+      EXPECT_NE(text.find(fmt("%.1f", s["entry_deg"].get<double>()) + " ± 1.1"), std::string::npos);
+      EXPECT_NE(text.find(fmt("%.1f", s["exit_deg"].get<double>()) + " ± 1.3"), std::string::npos);
+    }
+  // Forces and controls of the step table.
+  for (const char* v : {"410", "435", "460", "980", "940", "900", "1.25", "1.2", "1.15"})
+    EXPECT_NE(text.find(v), std::string::npos) << v;
+  EXPECT_NE(text.find("more twisted than designed"), std::string::npos);
+
+  // The 3D page of every step: each shape view (side, astern, top) shows the
+  // design's blue grid and the flying red surface; the deviation map is not blank.
+  const int dpi = 72;
+  // From astern and above the sail is seen edge-on and the grid drawn over
+  // the surface may hide it: the flying red is required from the side.
+  struct Frame { float x, y, w, h; bool blue, red; };
+  const Frame frames[] = {{42, 58, 190, 330, true, true},        // side
+                          {252.5f, 58, 90, 330, true, false},    // astern
+                          {363, 58, 190, 330, false, false},     // deviation
+                          {42, 422, 250, 190, true, false}};     // top
+  for (int page = 2; page < 2 + kSteps; ++page) {
+    SCOPED_TRACE("page " + std::to_string(page));
+    const Raster r = pageRaster(p.out_path, page, dpi);
+    ASSERT_GT(r.width, 0);
+    for (const Frame& f : frames) {
+      const Colours c = countColours(r, dpi, f.x + 2, f.y + 2, f.w - 4, f.h - 4);
+      SCOPED_TRACE("view at " + std::to_string(f.x) + ", " + std::to_string(f.y));
+      EXPECT_GT(c.ink, c.pixels / 40);
+      if (f.blue) EXPECT_GT(c.blue, c.pixels / 100);
+      if (f.red) EXPECT_GT(c.red, c.pixels / 20);
+    }
+  }
+}
+
+TEST(TrimReport, CrewReportIsShorterAndInPlainWords) {
+  TrimReportParams p = fixture().params("crew.pdf");
+  p.audience = "crew";
+  const TrimReport report = writeTrimReport(p);
+  EXPECT_EQ(report.pages, 4);  // cover, 3D views of the last step, plots, step changes
+  EXPECT_EQ(pdfPages(p.out_path), 4);
+  const std::string text = pdfText(p.out_path);
+  EXPECT_NE(text.find("How the sail flew"), std::string::npos);
+  EXPECT_NE(text.find("on average"), std::string::npos);
+  EXPECT_NE(text.find("sheet 1.25 → 1.2"), std::string::npos);
+  EXPECT_FALSE(std::regex_search(text, std::regex("[0-9] ± [0-9]")));  // no uncertainties in the crew's numbers
+}
+
+TEST(TrimReport, SingleScanReport) {
+  TrimReportParams p = fixture().params("scan.pdf");
+  p.test.clear();
+  p.scan_id = fixture().scan_ids[1];
+  const TrimReport report = writeTrimReport(p);
+  EXPECT_EQ(report.pages, 5);  // cover, 3D, table, plots, curves
+  EXPECT_EQ(pdfPages(p.out_path), 5);
+  const std::string text = pdfText(p.out_path);
+  const auto& s = fixture().docs[1]["sections"][7];
+  EXPECT_NE(text.find(fmt("%.1f", s["twist_deg"].get<double>()) + " ± 0.2"), std::string::npos);
+  EXPECT_EQ(text.find("what changed"), std::string::npos);
+}
+
+TEST(TrimReport, BadRequestsThrowAndLeaveAnExistingFileAlone) {
+  const std::string keep = fixture().dir.file("keep.pdf");
+  { std::ofstream(keep) << "an earlier report"; }
+  TrimReportParams p = fixture().params("keep.pdf");
+  p.test.clear();
+  p.scan_id = 999;
+  EXPECT_THROW(writeTrimReport(p), InvalidInput);  // unknown scan
+  EXPECT_EQ(test::readBytes(keep), "an earlier report");
+  p = fixture().params("x.pdf");
+  p.test = "no such test";
+  EXPECT_THROW(writeTrimReport(p), InvalidInput);
+  p = fixture().params("x.pdf");
+  p.db_path = fixture().dir.file("missing.sailshape");
+  EXPECT_THROW(writeTrimReport(p), InvalidInput);
+  EXPECT_FALSE(std::filesystem::exists(p.db_path));
+  p = fixture().params("x.pdf");
+  p.out_path = fixture().dir.file("no/such/folder/x.pdf");
+  EXPECT_THROW(writeTrimReport(p), InvalidInput);
+  p.out_path = fixture().dir.file("");
+  EXPECT_THROW(writeTrimReport(p), InvalidInput);  // a directory
+  p = fixture().params("x.pdf");
+  p.audience = "owner";
+  EXPECT_THROW(writeTrimReport(p), InvalidInput);
+  p = fixture().params("x.pdf");
+  p.scan_id = fixture().scan_ids[0];  // and a test
+  EXPECT_THROW(writeTrimReport(p), InvalidInput);
+  p = fixture().params("x.pdf");
+  p.test.clear();
+  EXPECT_THROW(writeTrimReport(p), InvalidInput);
+  p = fixture().params("x.pdf");
+  p.fonts.regular = fixture().dir.file("no-font.ttf");
+  EXPECT_THROW(writeTrimReport(p), PdfError);
+  EXPECT_FALSE(std::filesystem::exists(p.out_path));
+}
+
+TEST(TrimReport, SailWithoutDesignAndScanWithoutAnalysisAreRefused) {
+  TempDir dir;
+  const std::string db_path = dir.file("nodesign.sailshape");
+  int64_t analysed = 0, bare = 0;
+  {
+    Database db = openSailDatabase(db_path);
+    nlohmann::json doc = test::analysisDoc(10.0);
+    ImportMetadata meta;
+    meta.sail = "plain";
+    analysed = importScan(db, meta, &doc).scan_id;
+    Cloud cloud;
+    cloud.points = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1)};
+    meta.trim_step = 1;
+    bare = importScan(db, meta, nullptr, &cloud).scan_id;
+  }
+  TrimReportParams p;
+  p.db_path = db_path;
+  p.out_path = dir.file("x.pdf");
+  p.scan_id = analysed;
+  EXPECT_THROW(prepareTrimReport(p), InvalidInput);  // no design mesh
+  p.scan_id = bare;
+  EXPECT_THROW(prepareTrimReport(p), InvalidInput);  // no analysis
+  const std::string foreign = dir.file("foreign.txt");
+  { std::ofstream(foreign) << "not a database at all, just some text that is long enough"; }
+  p.db_path = foreign;
+  EXPECT_THROW(prepareTrimReport(p), DatabaseError);
+}
+
+TEST(PrivateDisplay, StartsXvfbWithoutDisplayAndStopsIt) {
+  ASSERT_EQ(std::getenv("DISPLAY"), nullptr);
+  {
+    PrivateDisplay display;
+    EXPECT_TRUE(display.started());
+    ASSERT_NE(std::getenv("DISPLAY"), nullptr);
+    EXPECT_EQ(display.display(), std::getenv("DISPLAY"));
+    EXPECT_EQ(display.display()[0], ':');
+  }
+  EXPECT_EQ(std::getenv("DISPLAY"), nullptr);
+}
+
+TEST(PrivateDisplay, FailsWithOneClearLineWhenXvfbIsMissing) {
+  TempDir empty;
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", empty.file("").c_str(), 1);
+  try {
+    PrivateDisplay display;
+    ADD_FAILURE() << "no exception";
+  } catch (const DisplayError& e) {
+    EXPECT_NE(std::string(e.what()).find("Xvfb is not installed"), std::string::npos);
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+  setenv("PATH", path.c_str(), 1);
+}
+
+TEST(ReportParts, BadInputsThrow) {
+  EXPECT_THROW(loftSections({}), InvalidInput);
+  ReportSection one;
+  one.curve = {Vec3(0, 0, 1), Vec3(1, 0, 1)};
+  EXPECT_THROW(loftSections({one}), InvalidInput);
+  EXPECT_THROW(loftSections({one, one}, 1), InvalidInput);
+  const Mesh mesh = generateSailMesh(exampleDesign(SailType::Main), 10, 6);
+  EXPECT_THROW(renderSailViews(Mesh{}, mesh, std::vector<double>(mesh.vertices.size())), InvalidInput);
+  EXPECT_THROW(renderSailViews(mesh, mesh, {1.0}), InvalidInput);
+  RenderParams tiny;
+  tiny.top.width_px = 2;
+  EXPECT_THROW(renderSailViews(mesh, mesh, std::vector<double>(mesh.vertices.size()), tiny), InvalidInput);
+  PdfFonts bad;
+  bad.bold = "/nonexistent/font.ttf";
+  EXPECT_THROW(PdfDocument{bad}, PdfError);
+  PdfDocument pdf;
+  EXPECT_THROW(pdf.text(0, 0, "x", 10), PdfError);  // before a page
+  pdf.addPage();
+  RgbImage broken;
+  broken.width = 4;
+  broken.height = 4;
+  EXPECT_THROW(pdf.image(broken, 0, 0, 10, 10), PdfError);
+  TempDir dir;
+  EXPECT_THROW(pdf.save(dir.file("missing/x.pdf")), PdfError);
+  SummaryParams negative;
+  negative.twist_deg = -1;
+  EXPECT_THROW(summarizeDifferences({}, negative), InvalidInput);
+}
+
+TEST(ReportParts, LoftPassesThroughTheSectionCurves) {
+  ReportSection a, b;
+  for (int i = 0; i <= 10; ++i) {
+    a.curve.push_back(Vec3(i * 0.3, 0.1 * std::sin(i * 0.314), 1.0));
+    b.curve.push_back(Vec3(i * 0.2, 0.08 * std::sin(i * 0.314), 3.0));
+  }
+  const Mesh m = loftSections({a, b}, 11, 3);
+  ASSERT_EQ(m.vertices.size(), 5u * 11u);
+  EXPECT_EQ(m.triangles.size(), 4u * 10u * 2u);
+  for (int i = 0; i <= 10; ++i) {
+    EXPECT_NEAR((m.vertices[i] - a.curve[i]).norm(), 0, 0.02);  // arc-length resampling of a gentle curve
+    EXPECT_NEAR((m.vertices[4 * 11 + i] - b.curve[i]).norm(), 0, 0.02);
+  }
+  EXPECT_NEAR(m.vertices[2 * 11].z(), 2.0, 1e-12);
+}
+
+TEST(ReportParts, GridEdgesDropQuadDiagonals) {
+  // A 3 × 2 grid of unit squares, each split along a diagonal: 17 grid edges, no diagonal.
+  Mesh m;
+  for (int r = 0; r <= 2; ++r)
+    for (int c = 0; c <= 3; ++c) m.vertices.push_back(Vec3(c, 0, r));
+  for (uint32_t r = 0; r < 2; ++r)
+    for (uint32_t c = 0; c < 3; ++c) {
+      const uint32_t a = r * 4 + c;
+      m.triangles.push_back({a, a + 1, a + 5});
+      m.triangles.push_back({a, a + 5, a + 4});
+    }
+  const auto edges = gridEdges(m);
+  EXPECT_EQ(edges.size(), 17u);
+  for (const auto& e : edges) EXPECT_NEAR((m.vertices[e[0]] - m.vertices[e[1]]).norm(), 1.0, 1e-12);
+}
+
+TEST(ReportSummary, NamesHeightsAndWordsTheLargestDifferences) {
+  EXPECT_EQ(heightName(0.1), "foot");
+  EXPECT_EQ(heightName(0.5), "middle");
+  EXPECT_EQ(heightName(0.9), "head");
+  const auto names = sectionNames({0.25, 0.5, 0.75});
+  EXPECT_EQ(names[0], "the lower section");
+  EXPECT_EQ(names[2], "the upper section");
+  EXPECT_EQ(sectionNames({0.85, 0.9})[1], "the head section at 90 % height");
+
+  ComparedSection head;
+  head.fraction = 0.85;
+  head.design = {3.0, 10.0, 45.0, 20.0, 0, 20.0, 10.0};
+  head.flying = {3.0, 10.3, 47.0, 24.1, 0, 20.5, 6.0};
+  head.design_u = {0.001, 0.05, 0.5, 0.05, 0, 0.5, 0.5};
+  head.flying_u = {0.006, 0.15, 0.9, 0.2, 0, 1.0, 1.2};
+  const Summary s = summarizeDifferences({head});
+  ASSERT_EQ(s.sentences.size(), 2u);  // twist 4.1° and exit 4.0°; camber 0.3 % and draft 2 % (< 2σ) are not worth a word
+  EXPECT_EQ(s.sentences[0], "The head section is 4.1° more twisted than designed.");
+  EXPECT_EQ(s.sentences[1], "The head section has a leech 4.0° more open than designed.");
+  EXPECT_FALSE(s.within_design);
+  head.flying = head.design;
+  EXPECT_TRUE(summarizeDifferences({head}).within_design);
+}
+
+TEST(ReportCli, ExitCodesAndOneLineErrors) {
+  const std::filesystem::path dir = fixture().dir.file("");
+  auto r = testing::runSailshape(dir, "report --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* opt : {"--db", "--scan", "--test", "--out", "--audience", "crew", "designer"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+  const std::string out = fixture().dir.file("cli.pdf");
+  r = testing::runSailshape(dir, "report -q --db '" + fixture().db_path + "' --scan 999 --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("no scan with id 999"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
+  r = testing::runSailshape(dir, "report -q --db '" + fixture().dir.file("missing.db") + "' --scan 1 --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+  r = testing::runSailshape(dir, "report -q --db '" + fixture().db_path + "' --scan 1 --out /nonexistent-dir/x.pdf");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("cannot write"), std::string::npos) << r.err;
+  r = testing::runSailshape(dir, "report --db '" + fixture().db_path + "' --scan 1 --test x --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 2);  // CLI11: --scan excludes --test
+  r = testing::runSailshape(dir, "report --db '" + fixture().db_path + "' --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  r = testing::runSailshape(dir, "report --db '" + fixture().db_path + "' --scan 1 --audience owner --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(out));
+  r = testing::runSailshape(dir, "report -q --db '" + fixture().db_path + "' --test '" + kTest + "' --audience crew --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(pdfPages(out), 4);
+}
+
+}  // namespace
+}  // namespace sailshape
