@@ -551,6 +551,22 @@ void changesPage(PdfDocument& pdf, Pages& pages, const TrimReportData& r, bool c
     }
     y += 28;
   }
+  // Which step pulled best, when forces were measured.
+  const ReportStep* most_drive = nullptr;
+  const ReportStep* best_ratio = nullptr;
+  for (const auto& s : d.steps) {
+    if (s.drive_n && (!most_drive || *s.drive_n > *most_drive->drive_n)) most_drive = &s;
+    if (s.drive_n && s.side_n && *s.side_n > 0 &&
+        (!best_ratio || *s.drive_n / *s.side_n > *best_ratio->drive_n / *best_ratio->side_n))
+      best_ratio = &s;
+  }
+  if (most_drive) {
+    std::string best = "Most drive: " + stepLabel(d, *most_drive) + " (" + fmt("%.0f N", *most_drive->drive_n) + ")";
+    if (best_ratio)
+      best += "; best drive for its side force: " + stepLabel(d, *best_ratio) + " (drive/side " +
+              fmt("%.2f", *best_ratio->drive_n / *best_ratio->side_n) + ")";
+    y = pdf.paragraph(kMargin, y + 4, w - 2 * kMargin, best + ".", 9.5f, true, kNavy);
+  }
   y += 12;
 
   const auto names = [&] {
@@ -600,6 +616,11 @@ void changesPage(PdfDocument& pdf, Pages& pages, const TrimReportData& r, bool c
           if (std::abs(dv) > std::abs(best)) best = dv, best_f = p.b->fraction;
         }
         if (!n) continue;
+        // Changes below half a tenth do not print as a change at one decimal.
+        if (std::abs(best) < 0.05) {
+          words += std::string(words.empty() ? "" : "; ") + label[k] + " unchanged";
+          continue;
+        }
         words += std::string(words.empty() ? "" : "; ") + label[k] + " " + signedFmt("%+.1f", sum / n) + unit[k] +
                  " on average, most at the " + heightName(best_f) + " (" + signedFmt("%+.1f", best) + unit[k] + ")";
       }

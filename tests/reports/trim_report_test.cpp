@@ -283,8 +283,12 @@ TEST(TrimReport, DesignerReportShowsTheDatabaseNumbersAndBothColours) {
       const Colours c = countColours(r, dpi, f.x + 2, f.y + 2, f.w - 4, f.h - 4);
       SCOPED_TRACE("view at " + std::to_string(f.x) + ", " + std::to_string(f.y));
       EXPECT_GT(c.ink, c.pixels / 40);
-      if (f.blue) EXPECT_GT(c.blue, c.pixels / 100);
-      if (f.red) EXPECT_GT(c.red, c.pixels / 20);
+      if (f.blue) {
+        EXPECT_GT(c.blue, c.pixels / 100);
+      }
+      if (f.red) {
+        EXPECT_GT(c.red, c.pixels / 20);
+      }
     }
   }
 }
