@@ -729,7 +729,7 @@ TrimReportData prepareTrimReport(const TrimReportParams& p, const Progress& prog
   const MeshSections design = analyzeMeshSections(*r.data.design_mesh, {}, sp, p.design_sampling);
   r.design_sections = design.sections;
   r.warnings = design.sections.warnings;
-  r.warnings.insert(r.warnings.end(), design.notes.begin(), design.notes.end());
+  r.notes = design.notes;
   progress("design", 0.6);
 
   const DesignDistance distance(*r.data.design_mesh);

@@ -52,6 +52,7 @@ struct TrimReportData {
   std::vector<StepComparison> steps;
   Summary summary;                  // of the last step
   std::vector<std::string> warnings;
+  std::vector<std::string> notes;   // how the design was analysed (e.g. resampled)
 };
 
 // Loads and compares without writing anything. Throws InvalidInput for bad
