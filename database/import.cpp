@@ -33,6 +33,56 @@ void requireFinite(const std::optional<double>& v, const char* name) {
     throw InvalidInput(std::string("[importScan] ") + name + " must be finite (got " + std::to_string(*v) + ")");
 }
 
+// Writes the analysis row and its sections; the caller holds the transaction.
+int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, const std::string& software_version,
+                      const char* function, size_t* sections_written, const ImportHook& hook) {
+  Statement a = db.prepare(
+      "INSERT INTO analyses(scan_id, software_version, params, sail, diagnostics) VALUES (?, ?, ?, ?, ?)");
+  a.bind(1, scan_id).bind(2, software_version);
+  auto json_or_null = [&](int index, const char* key) {
+    if (doc.contains(key)) a.bind(index, doc[key].dump()); else a.bindNull(index);
+  };
+  json_or_null(3, "parameters");
+  nlohmann::json sail = doc.value("sail", nlohmann::json::object());
+  if (doc.contains("luff")) sail["luff"] = doc["luff"];
+  a.bind(4, sail.dump());
+  json_or_null(5, "diagnostics");
+  a.run();
+  const int64_t analysis_id = db.lastInsertId();
+  if (hook) hook("analysis");
+
+  Statement sec = db.prepare(
+      "INSERT INTO sections(analysis_id, fraction, chord_m, camber_pct, draft_pct, twist_deg, twist_rel_deg, entry_deg,"
+      " exit_deg, u_chord_m, u_camber_pct, u_draft_pct, u_twist_deg, u_twist_rel_deg, u_entry_deg, u_exit_deg,"
+      " plane_tilt_deg, converged, curve) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  for (const nlohmann::json& j : doc["sections"]) {
+    const auto fraction = number(j, "fraction");
+    if (!fraction || *fraction <= 0 || *fraction >= 1)
+      throw InvalidInput(std::string("[") + function + "] section fraction must be in (0, 1) (got " +
+                         j.value("fraction", nlohmann::json()).dump() + ")");
+    sec.bind(1, analysis_id).bind(2, *fraction);
+    const nlohmann::json u = j.value("uncertainty", nlohmann::json::object());
+    for (int k = 0; k < 7; ++k) {
+      sec.bind(3 + k, number(j, kParameters[k]));
+      sec.bind(10 + k, number(u, kParameters[k]));
+    }
+    sec.bind(17, number(j, "plane_tilt_deg"));
+    sec.bind(18, j.value("converged", true) ? 1 : 0);
+    std::vector<Vec3> curve;
+    if (j.contains("curve"))
+      for (const auto& p : j["curve"]) curve.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+    sec.bindBlob(19, packCurve(curve));
+    sec.run();
+    sec.reset();
+    if (sections_written) ++*sections_written;
+  }
+  return analysis_id;
+}
+
+bool hasSectionsArray(const nlohmann::json& doc) {
+  return doc.is_object() && doc.contains("sections") && doc["sections"].is_array();
+}
+
 }  // namespace
 
 std::vector<uint8_t> packCurve(const std::vector<Vec3>& curve) {
@@ -60,7 +110,7 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
   if (meta.awa_deg && (*meta.awa_deg < -180 || *meta.awa_deg > 360))
     throw InvalidInput("[importScan] awa_deg must be in [-180, 360] (got " + std::to_string(*meta.awa_deg) + ")");
   if (!analysis && !cloud) throw InvalidInput("[importScan] nothing to import: neither an analysis nor a cloud");
-  if (analysis && (!analysis->is_object() || !analysis->contains("sections") || !(*analysis)["sections"].is_array()))
+  if (analysis && !hasSectionsArray(*analysis))
     throw InvalidInput("[importScan] the analysis document has no \"sections\" array (is it `sailshape analyze --json` output?)");
   for (const auto& [name, value] : meta.controls)
     if (name.empty() || !std::isfinite(value))
@@ -156,50 +206,24 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
   if (hook) hook("scan");
 
   if (analysis) {
-    const nlohmann::json& doc = *analysis;
-    Statement a = db.prepare(
-        "INSERT INTO analyses(scan_id, software_version, params, sail, diagnostics) VALUES (?, ?, ?, ?, ?)");
-    a.bind(1, result.scan_id).bind(2, meta.software_version);
-    auto json_or_null = [&](int index, const char* key) {
-      if (doc.contains(key)) a.bind(index, doc[key].dump()); else a.bindNull(index);
-    };
-    json_or_null(3, "parameters");
-    nlohmann::json sail = doc.value("sail", nlohmann::json::object());
-    if (doc.contains("luff")) sail["luff"] = doc["luff"];
-    a.bind(4, sail.dump());
-    json_or_null(5, "diagnostics");
-    a.run();
-    result.analysis_id = db.lastInsertId();
-    if (hook) hook("analysis");
-
-    Statement sec = db.prepare(
-        "INSERT INTO sections(analysis_id, fraction, chord_m, camber_pct, draft_pct, twist_deg, twist_rel_deg, entry_deg,"
-        " exit_deg, u_chord_m, u_camber_pct, u_draft_pct, u_twist_deg, u_twist_rel_deg, u_entry_deg, u_exit_deg,"
-        " plane_tilt_deg, converged, curve) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    for (const nlohmann::json& j : doc["sections"]) {
-      const auto fraction = number(j, "fraction");
-      if (!fraction || *fraction <= 0 || *fraction >= 1)
-        throw InvalidInput("[importScan] section fraction must be in (0, 1) (got " + j.value("fraction", nlohmann::json()).dump() + ")");
-      sec.bind(1, result.analysis_id).bind(2, *fraction);
-      const nlohmann::json u = j.value("uncertainty", nlohmann::json::object());
-      for (int k = 0; k < 7; ++k) {
-        sec.bind(3 + k, number(j, kParameters[k]));
-        sec.bind(10 + k, number(u, kParameters[k]));
-      }
-      sec.bind(17, number(j, "plane_tilt_deg"));
-      sec.bind(18, j.value("converged", true) ? 1 : 0);
-      std::vector<Vec3> curve;
-      if (j.contains("curve"))
-        for (const auto& p : j["curve"]) curve.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
-      sec.bindBlob(19, packCurve(curve));
-      sec.run();
-      sec.reset();
-      ++result.sections;
-    }
+    result.analysis_id =
+        writeAnalysis(db, result.scan_id, *analysis, meta.software_version, "importScan", &result.sections, hook);
     if (hook) hook("sections");
   }
   tx.commit();
   return result;
+}
+
+int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis, const std::string& software_version) {
+  if (!hasSectionsArray(analysis))
+    throw InvalidInput("[addAnalysis] the analysis document has no \"sections\" array");
+  Transaction tx(db);
+  Statement s = db.prepare("SELECT 1 FROM scans WHERE id = ?");
+  s.bind(1, scan_id);
+  if (!s.step()) throw InvalidInput("[addAnalysis] no scan with id " + std::to_string(scan_id));
+  const int64_t id = writeAnalysis(db, scan_id, analysis, software_version, "addAnalysis", nullptr, {});
+  tx.commit();
+  return id;
 }
 
 }  // namespace sailshape

@@ -54,6 +54,13 @@ using ImportHook = std::function<void(const std::string& stage)>;
 ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis,
                         const Cloud* cloud = nullptr, const ImportHook& hook = {});
 
+// Stores `analysis` (the JSON of `sailshape analyze --json`) as a new analysis of
+// an existing scan, in one transaction; the scan's earlier analyses stay. Returns
+// the analysis id. Throws InvalidInput for a missing scan or a document without
+// a "sections" array or with a fraction outside (0, 1).
+int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis,
+                    const std::string& software_version = "0.1.0");
+
 // N×3 float64 little-endian, the layout of sections.curve.
 std::vector<uint8_t> packCurve(const std::vector<Vec3>& curve);
 std::vector<Vec3> unpackCurve(const std::vector<uint8_t>& blob);

@@ -1,0 +1,78 @@
+#include "database/scan_record.hpp"
+
+#include <limits>
+
+#include "analysis/errors.hpp"
+#include "database/cloud_blob.hpp"
+#include "database/import.hpp"
+
+namespace sailshape {
+namespace {
+
+SectionParameters readParameters(const Statement& s, int first) {
+  // NULL (not measurable, e.g. no exit angle) stays visible as NaN.
+  auto v = [&](int k) { return s.isNull(first + k) ? std::numeric_limits<double>::quiet_NaN() : s.columnDouble(first + k); };
+  SectionParameters p;
+  p.chord_m = v(0);
+  p.camber_pct = v(1);
+  p.draft_pct = v(2);
+  p.twist_deg = v(3);
+  p.twist_rel_deg = v(4);
+  p.entry_deg = v(5);
+  p.exit_deg = v(6);
+  return p;
+}
+
+}  // namespace
+
+ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
+  Statement s = db.prepare(
+      "SELECT s.id, s.trim_step_id, s.scanned_at, s.cloud, c.name, t.test, t.step_order, t.awa_deg, sa.name,"
+      " sa.design_mesh IS NOT NULL, (SELECT max(a.id) FROM analyses a WHERE a.scan_id = s.id)"
+      " FROM scans s LEFT JOIN trim_steps t ON t.id = s.trim_step_id LEFT JOIN sessions se ON se.id = t.session_id"
+      " LEFT JOIN campaigns c ON c.id = se.campaign_id LEFT JOIN sails sa ON sa.id = t.sail_id WHERE s.id = ?");
+  s.bind(1, scan_id);
+  if (!s.step()) throw InvalidInput("[loadScanRecord] no scan with id " + std::to_string(scan_id));
+  ScanRecord r;
+  r.scan_id = s.columnInt(0);
+  r.trim_step_id = s.isNull(1) ? 0 : s.columnInt(1);
+  r.scanned_at = s.isNull(2) ? "" : s.columnText(2);
+  if (!s.isNull(3)) r.cloud = decompressCloud(s.columnBlob(3));
+  r.campaign = s.isNull(4) ? "" : s.columnText(4);
+  r.test = s.isNull(5) ? "" : s.columnText(5);
+  r.step = s.isNull(6) ? 0 : static_cast<int>(s.columnInt(6));
+  if (!s.isNull(7)) r.awa_deg = s.columnDouble(7);
+  r.sail = s.isNull(8) ? "" : s.columnText(8);
+  r.has_design = !s.isNull(9) && s.columnInt(9) != 0;
+  r.analysis_id = s.isNull(10) ? 0 : s.columnInt(10);
+  if (r.analysis_id == 0) return r;
+
+  Statement a = db.prepare("SELECT params FROM analyses WHERE id = ?");
+  a.bind(1, r.analysis_id);
+  if (a.step() && !a.isNull(0)) r.analysis_params = nlohmann::json::parse(a.columnText(0), nullptr, false);
+  if (r.analysis_params.is_discarded()) r.analysis_params = nullptr;
+
+  Statement x = db.prepare(
+      "SELECT fraction, chord_m, camber_pct, draft_pct, twist_deg, twist_rel_deg, entry_deg, exit_deg, u_chord_m,"
+      " u_camber_pct, u_draft_pct, u_twist_deg, u_twist_rel_deg, u_entry_deg, u_exit_deg, plane_tilt_deg, converged,"
+      " curve FROM sections WHERE analysis_id = ? ORDER BY fraction");
+  x.bind(1, r.analysis_id);
+  while (x.step()) {
+    Section sec;
+    sec.fraction = x.columnDouble(0);
+    sec.value = readParameters(x, 1);
+    sec.uncertainty = readParameters(x, 8);
+    sec.plane_tilt_deg = x.isNull(15) ? 0.0 : x.columnDouble(15);
+    sec.converged = x.columnInt(16) != 0;
+    if (!x.isNull(17)) sec.curve = unpackCurve(x.columnBlob(17));
+    if (!sec.curve.empty()) {
+      sec.luff_point = sec.curve.front();
+      sec.leech_point = sec.curve.back();
+    }
+    sec.curve_samples = sec.curve.size();
+    r.sections.sections.push_back(std::move(sec));
+  }
+  return r;
+}
+
+}  // namespace sailshape

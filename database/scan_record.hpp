@@ -1,0 +1,35 @@
+#pragma once
+// One stored scan read back for display and re-analysis: its place in the
+// catalogue, the cloud and the sections of its latest analysis.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/cloud.hpp"
+#include "analysis/sections.hpp"
+#include "database/sqlite.hpp"
+
+namespace sailshape {
+
+struct ScanRecord {
+  int64_t scan_id = 0;
+  int64_t trim_step_id = 0;
+  int64_t analysis_id = 0;         // latest analysis; 0 when the scan has none
+  std::string campaign, test, sail, scanned_at;
+  int step = 0;
+  std::optional<double> awa_deg;
+  bool has_design = false;         // the sail has a stored design mesh
+  std::optional<Cloud> cloud;      // absent when only the analysis was imported
+  // The latest analysis's sections; luff/leech points are the curve's ends and
+  // max_camber_point is not stored (left zero); a parameter stored as NULL
+  // (not measurable) is NaN.
+  SectionAnalysis sections;
+  nlohmann::json analysis_params;  // the pipeline parameters it ran with (null when unknown)
+};
+
+// Throws InvalidInput when there is no scan `scan_id`, DatabaseError for a damaged cloud blob.
+ScanRecord loadScanRecord(Database& db, int64_t scan_id);
+
+}  // namespace sailshape

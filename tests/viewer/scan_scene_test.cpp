@@ -1,0 +1,96 @@
+#include <gtest/gtest.h>
+
+#include "analysis/errors.hpp"
+#include "database/catalog.hpp"
+#include "database/scan_record.hpp"
+#include "viewer/scan_scene.hpp"
+#include "viewer/worker.hpp"
+#include "viewer_fixture.hpp"
+
+namespace sailshape::viewer {
+namespace {
+
+// The flying shape is the design with camber +2 % and twist +3° at every station
+// (viewer_fixture.hpp); the scene must find those differences within the
+// 1σ uncertainties the pipeline derives from the 4 mm sensor noise.
+TEST(ScanScene, FindsTheKnownTrimAgainstTheDesign) {
+  test::TempDir dir;
+  const std::string path = dir.file("s.sqlite");
+  test::makeSailDatabase(path, 1);
+  Database db = openSailDatabase(path);
+  ScanRecord record = loadScanRecord(db, 1);
+  ASSERT_TRUE(record.has_design);
+  const Mesh design = sailDesignMesh(db, record.sail);
+
+  const ScanScene scene = buildScanScene(record, design);
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
+  ASSERT_TRUE(scene.analysis.has_value());
+  EXPECT_FALSE(scene.surface.empty());
+  EXPECT_EQ(scene.surface_deviation_m.size(), scene.surface.vertices.size());
+  EXPECT_EQ(scene.raw_deviation_m.size(), scene.raw_cloud.size());
+  EXPECT_EQ(scene.raw_cloud.size(), 20'000u);
+  ASSERT_EQ(scene.sections.sections.size(), 3u);
+  ASSERT_EQ(scene.deltas.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    const SectionDelta& d = scene.deltas[k];
+    const SectionParameters& u = scene.sections.sections[k].uncertainty;
+    EXPECT_NEAR(d.delta.camber_pct, 2.0, 3 * u.camber_pct + 0.1) << "section " << k;
+    EXPECT_NEAR(d.delta.twist_deg, 3.0, 3 * u.twist_deg + 0.2) << "section " << k;
+    EXPECT_DOUBLE_EQ(d.flying.camber_pct, scene.sections.sections[k].value.camber_pct)
+        << "the table shows the stored sections";
+  }
+  // More camber and more twist both move the flying shape to leeward of the design.
+  ASSERT_TRUE(scene.deviation.has_value());
+  EXPECT_GT(scene.deviation->mean_m, 0.0);
+  EXPECT_GT(scene.deviation->p5_m, -3 * test::kSensorSigmaM);
+}
+
+TEST(ScanScene, WithoutDesignOrCloudItSaysWhatIsMissing) {
+  test::TempDir dir;
+  Database db = openSailDatabase(dir.file("s.sqlite"));
+  const auto doc = nlohmann::json{{"sections", nlohmann::json::array({{{"fraction", 0.5}, {"camber_pct", 11.0}}})}};
+  ImportMetadata meta;
+  const ImportResult r = importScan(db, meta, &doc);
+  const ScanScene scene = buildScanScene(loadScanRecord(db, r.scan_id), std::nullopt);
+  EXPECT_TRUE(scene.raw_cloud.empty());
+  EXPECT_TRUE(scene.surface.empty());
+  EXPECT_FALSE(scene.deviation.has_value());
+  EXPECT_TRUE(scene.deltas.empty());
+  ASSERT_EQ(scene.sections.sections.size(), 1u);
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_NE(scene.warnings[0].find("no stored cloud"), std::string::npos);
+}
+
+TEST(ScanScene, APipelineFailureBecomesAWarning) {
+  ScanRecord record;
+  record.cloud = Cloud{};
+  record.cloud->points = {Vec3(0, 0, 0), Vec3(1, 0, 0)};  // too few points for any surface
+  const ScanScene scene = buildScanScene(record, std::nullopt);
+  EXPECT_TRUE(scene.surface.empty());
+  ASSERT_FALSE(scene.warnings.empty());
+  EXPECT_NE(scene.warnings[0].find("pipeline failed"), std::string::npos);
+  EXPECT_EQ(scene.raw_cloud.size(), 2u);
+}
+
+TEST(ScanScene, CancelUnwindsThroughTheProgressCallback) {
+  test::TempDir dir;
+  const std::string path = dir.file("s.sqlite");
+  test::makeSailDatabase(path, 1);
+  Database db = openSailDatabase(path);
+  Progress cancel;
+  cancel.callback = [](std::string_view, double) { throw Cancelled(); };
+  EXPECT_THROW(buildScanScene(loadScanRecord(db, 1), std::nullopt, {}, cancel), Cancelled);
+}
+
+TEST(ScanScene, ThinCloudKeepsEveryKthPoint) {
+  Cloud c;
+  for (int i = 0; i < 10; ++i) c.points.emplace_back(i, 0, 0);
+  const Cloud t = thinCloud(c, 4);
+  ASSERT_EQ(t.size(), 4u);  // step 3: 0, 3, 6, 9
+  EXPECT_DOUBLE_EQ(t.points[3].x(), 9.0);
+  EXPECT_EQ(thinCloud(c, 10).size(), 10u);
+  EXPECT_THROW(thinCloud(c, 0), InvalidInput);
+}
+
+}  // namespace
+}  // namespace sailshape::viewer

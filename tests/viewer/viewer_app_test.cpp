@@ -1,0 +1,200 @@
+// The built sailshape-viewer run as a user would, under a private X server
+// (xvfb-run), judged by what its screenshot shows.
+#include <gtest/gtest.h>
+#include <stb_image.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <memory>
+#include <string>
+
+#include "viewer_fixture.hpp"
+
+namespace sailshape::viewer {
+namespace {
+
+constexpr int kWidth = 1600, kHeight = 1000;
+
+struct ViewerRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+ViewerRun runViewer(const test::TempDir& dir, const std::string& args) {
+  std::string launcher;
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") == 0)
+    launcher = "xvfb-run -a -s '-screen 0 1920x1200x24' ";  // a private server even when DISPLAY is set
+  else if (!std::getenv("DISPLAY"))
+    ADD_FAILURE() << "neither xvfb-run nor a DISPLAY: install xvfb (scripts/setup)";
+  const std::string out = dir.file("stdout.txt"), err = dir.file("stderr.txt");
+  const std::string cmd = launcher + quote(SAILSHAPE_VIEWER_BIN) + " " + args + " --width " + std::to_string(kWidth) +
+                          " --height " + std::to_string(kHeight) + " </dev/null >" + quote(out) + " 2>" + quote(err);
+  const int status = std::system(cmd.c_str());
+  ViewerRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+struct Image {
+  int width = 0, height = 0;
+  std::unique_ptr<unsigned char, void (*)(void*)> rgb{nullptr, stbi_image_free};
+  const unsigned char* at(int x, int y) const { return rgb.get() + 3 * (static_cast<size_t>(y) * width + x); }
+};
+
+Image load(const std::string& path) {
+  Image img;
+  int channels = 0;
+  img.rgb.reset(stbi_load(path.c_str(), &img.width, &img.height, &channels, 3));
+  return img;
+}
+
+struct Rect {
+  int x0, y0, x1, y1;
+};
+
+// The fixed layout of a 1600 × 1000 window (viewer/app.cpp): toolbar 40 px, status
+// bar 28 px, browser 300 px on the left, analysis panel 440 px on the right, the
+// 3D view over 64 % of the middle height and the plots below; a few pixels in
+// from every edge and below the panel title bars.
+const Rect kView{310, 70, 1150, 626};
+const Rect kPlots{310, 690, 1150, 960};
+const Rect kBrowser{6, 62, 294, 600};
+const Rect kAnalysis{1166, 62, 1594, 900};
+// The scalar bar: 90–98 % of the view's width, 12–88 % of its height.
+const Rect kScalarBar{1080, 140, 1140, 560};
+
+using Pixel = std::function<bool(int r, int g, int b)>;
+
+size_t count(const Image& img, const Rect& r, const Pixel& is) {
+  size_t n = 0;
+  for (int y = r.y0; y < r.y1; ++y)
+    for (int x = r.x0; x < r.x1; ++x) {
+      const unsigned char* p = img.at(x, y);
+      if (is(p[0], p[1], p[2])) ++n;
+    }
+  return n;
+}
+
+double area(const Rect& r) { return double(r.x1 - r.x0) * (r.y1 - r.y0); }
+
+// The design's blue (64, 140, 255) and the flying shape's red (220, 34, 26), shaded.
+const Pixel kBlue = [](int r, int g, int b) { return b > 170 && b > r + 80 && b > g + 40; };
+const Pixel kRed = [](int r, int g, int b) { return r > 110 && r > 2 * g && r > 2 * b; };
+const Pixel kText = [](int r, int g, int b) { return r > 170 && g > 170 && b > 170; };
+const Pixel kErrorText = [](int r, int g, int b) { return r > 200 && g > 80 && g < 160 && b < 160 && r > g + 60; };
+
+class ViewerApp : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir;
+    test::makeSailDatabase(dir_->file("sails.sqlite"), 2);
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  static test::TempDir* dir_;
+};
+test::TempDir* ViewerApp::dir_ = nullptr;
+
+TEST_F(ViewerApp, ShowsDesignAndFlyingAndDrawsThePanels) {
+  const std::string png = dir_->file("shot.png");
+  const ViewerRun r = runViewer(*dir_, quote(dir_->file("sails.sqlite")) + " --screenshot " + quote(png) + " --frames 4");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const Image img = load(png);
+  ASSERT_TRUE(img.rgb) << "no PNG at " << png;
+  ASSERT_EQ(img.width, kWidth);
+  ASSERT_EQ(img.height, kHeight);
+  // The flying surface fills a good part of the view, the design grid runs over it.
+  EXPECT_GT(count(img, kView, kRed) / area(kView), 0.03);
+  EXPECT_GT(count(img, kView, kBlue) / area(kView), 0.002);
+  // Plots: the design (blue) and flying (red) curves of camber, draft and twist.
+  EXPECT_GT(count(img, kPlots, kRed), 150u);
+  EXPECT_GT(count(img, kPlots, kBlue), 150u);
+  // Browser tree and section table carry text.
+  EXPECT_GT(count(img, kBrowser, kText), 300u);
+  EXPECT_GT(count(img, kAnalysis, kText), 1000u);
+  // No scalar bar without deviation colours.
+  EXPECT_LT(count(img, kScalarBar, kRed), 20u);
+}
+
+TEST_F(ViewerApp, DeviationColoursShowTheScalarBar) {
+  const std::string png = dir_->file("deviation.png");
+  const ViewerRun r = runViewer(*dir_, quote(dir_->file("sails.sqlite")) + " --deviation --screenshot " + quote(png) + " --frames 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image img = load(png);
+  ASSERT_TRUE(img.rgb);
+  // Cool-to-warm: the bar spans blue (to windward) to red (to leeward).
+  const Pixel bluish = [](int r, int, int b) { return b > r + 60; };
+  const Pixel reddish = [](int r, int, int b) { return r > b + 60; };
+  EXPECT_GT(count(img, kScalarBar, bluish), 200u);
+  EXPECT_GT(count(img, kScalarBar, reddish), 200u);
+}
+
+TEST_F(ViewerApp, SurvivesResizingToNothingAndMinimising) {
+  const std::string png = dir_->file("resized.png");
+  const ViewerRun r = runViewer(*dir_, quote(dir_->file("sails.sqlite")) + " --exercise-window --screenshot " + quote(png) +
+                                     " --frames 20");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image img = load(png);
+  ASSERT_TRUE(img.rgb);
+  ASSERT_EQ(img.width, kWidth) << "the window is back at its size after the exercise";
+  EXPECT_GT(count(img, kView, kRed) / area(kView), 0.03);
+  EXPECT_GT(count(img, kView, kBlue) / area(kView), 0.002);
+}
+
+TEST_F(ViewerApp, OpensAnEmptyDatabase) {
+  const std::string db = dir_->file("empty.sqlite");
+  { Database created = openSailDatabase(db); }
+  const std::string png = dir_->file("empty.png");
+  const ViewerRun r = runViewer(*dir_, quote(db) + " --screenshot " + quote(png) + " --frames 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const Image img = load(png);
+  ASSERT_TRUE(img.rgb);
+  EXPECT_LT(count(img, kView, kRed), 50u);
+  EXPECT_LT(count(img, kView, kBlue), 50u);
+  EXPECT_GT(count(img, kView, kText), 50u) << "the view says the database has no scans";
+  EXPECT_GT(count(img, kBrowser, kText), 100u);
+}
+
+TEST_F(ViewerApp, AMissingFileIsReportedAndNotCreated) {
+  const std::string missing = dir_->file("no-such.sqlite");
+  const std::string png = dir_->file("missing.png");
+  const ViewerRun r = runViewer(*dir_, quote(missing) + " --screenshot " + quote(png) + " --frames 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("database file not found: " + missing), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(missing));
+  const Image img = load(png);
+  ASSERT_TRUE(img.rgb);
+  EXPECT_GT(count(img, kView, kErrorText), 30u) << "the message is in the 3D view";
+  EXPECT_GT(count(img, kBrowser, kErrorText), 30u) << "and in the browser";
+}
+
+TEST_F(ViewerApp, RefusesBadOptions) {
+  const ViewerRun no_frames = runViewer(*dir_, "--screenshot " + quote(dir_->file("x.png")));
+  EXPECT_NE(no_frames.exit_code, 0);
+  EXPECT_NE(no_frames.err.find("--frames"), std::string::npos) << no_frames.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_->file("x.png")));
+}
+
+}  // namespace
+}  // namespace sailshape::viewer

@@ -1,0 +1,134 @@
+#pragma once
+// The viewer's window content: database browser, 3D view, section table,
+// plots, trim-step comparison, processing tabs. All UI state lives in the
+// structs below; drawing happens in App::frame() between ImGui::NewFrame and
+// ImGui::Render.
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "database/sqlite.hpp"
+#include "viewer/catalog_tree.hpp"
+#include "viewer/processing.hpp"
+#include "viewer/scan_scene.hpp"
+#include "viewer/section_table.hpp"
+#include "viewer/vtk_viewport.hpp"
+#include "viewer/worker.hpp"
+
+namespace sailshape::viewer {
+
+struct DatabaseState {
+  std::string path;                 // what was asked for
+  std::optional<Database> db;
+  std::string error;                // why it is not open
+  char path_input[1024] = {};
+};
+
+struct BrowserState {
+  CatalogTree tree;
+  int64_t selected_scan = 0;        // 0: none
+  std::set<int64_t> overlays;       // scans overlaid on the selected one
+};
+
+struct LoadState {
+  Task<ScanScene> task;
+  int64_t pending_scan = 0;         // the selected scan, waiting for the task to be free
+  int64_t loading_scan = 0;         // what the task is building
+  bool loading_overlay = false;
+  std::deque<int64_t> overlay_queue;
+  std::optional<ScanScene> scene;   // the selected scan, once built
+  std::map<int64_t, ScanScene> overlays;
+  SceneOptions options;
+};
+
+struct ProcessingState {
+  ProcessingParams params;
+  Task<StageResult> task;
+  std::optional<StageResult> result;
+  int64_t result_scan = 0;
+  bool show_result = true;
+  std::string note;                 // last save or failure
+};
+
+struct PickState {
+  std::optional<PickInfo> info;
+  float press_x = 0, press_y = 0;
+  bool pressed_in_view = false;
+};
+
+struct PlotState {
+  SectionField fields[3] = {SectionField::Camber, SectionField::Draft, SectionField::Twist};
+  SectionField compare_field = SectionField::Camber;
+};
+
+struct ViewState {
+  ViewOptions options;
+  bool rebuild = true;              // actors must be rebuilt before the next render
+  std::optional<CameraPreset> camera;
+  int width = 0, height = 0;        // last rendered size of the 3D view, pixels
+  bool hovered = false;
+};
+
+struct MessageLog {
+  std::vector<std::string> lines;   // newest last
+  void info(const std::string& text);
+  void error(const std::string& text);  // also written to stderr
+};
+
+class App {
+ public:
+  explicit App(std::optional<std::string> database_path);
+  ~App();
+
+  // Draws the whole window for one frame (display size in pixels).
+  void frame(float width, float height);
+  // True while a scan or processing job runs (the screenshot mode waits for it).
+  bool busy() const;
+  // Set once the viewer has nothing left to load (initial scan shown or none to show).
+  bool settled() const;
+  const MessageLog& log() const { return log_; }
+  bool databaseOpen() const { return database_.db.has_value(); }
+  void setDeviationView(bool on) {
+    view_.options.deviation = on;
+    view_.rebuild = true;
+  }
+
+ private:
+  void openDatabase(const std::string& path);
+  void selectScan(int64_t scan_id);
+  void pollJobs();
+  void startNextLoad();
+  void drawToolbar(float x, float y, float w, float h);
+  void drawBrowser(float x, float y, float w, float h);
+  void drawDisplayOptions();
+  void drawView(float x, float y, float w, float h);
+  void drawPlots(float x, float y, float w, float h);
+  void drawRightPanel(float x, float y, float w, float h);
+  void drawSectionTable();
+  void drawTrimComparison();
+  void drawProcessing();
+  void drawScanner();
+  void drawStatus(float x, float y, float w, float h);
+  std::vector<Overlay> overlayList() const;
+
+  DatabaseState database_;
+  BrowserState browser_;
+  LoadState load_;
+  ProcessingState processing_;
+  PickState pick_;
+  PlotState plots_;
+  ViewState view_;
+  MessageLog log_;
+  std::unique_ptr<VtkViewport> viewport_;
+  bool initial_load_done_ = false;
+};
+
+// The colour of the k-th overlaid trim step.
+Rgb overlayColour(size_t k);
+
+}  // namespace sailshape::viewer

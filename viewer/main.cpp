@@ -1,0 +1,235 @@
+// sailshape-viewer [DB]: the designer's desk. Dear ImGui on GLFW (OpenGL 3.2
+// core), VTK drawing the 3D view into a texture on the same context.
+#include <GLFW/glfw3.h>
+#include <GL/gl.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+#include <stb_image_write.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "viewer/app.hpp"
+
+namespace {
+
+using namespace sailshape::viewer;
+
+struct Options {
+  std::optional<std::string> database;
+  std::string screenshot;
+  int frames = 0;
+  int width = 1600, height = 1000;
+  bool exercise_window = false;
+  bool deviation = false;
+};
+
+// GLFW for the process: initialised once, terminated on scope exit.
+struct GlfwLibrary {
+  GlfwLibrary() {
+    glfwSetErrorCallback([](int code, const char* text) { std::cerr << "sailshape-viewer: GLFW error " << code << ": " << text << "\n"; });
+    if (!glfwInit()) throw std::runtime_error("[sailshape-viewer] cannot initialise GLFW (no display? set DISPLAY or run under xvfb-run)");
+  }
+  ~GlfwLibrary() { glfwTerminate(); }
+  GlfwLibrary(const GlfwLibrary&) = delete;
+  GlfwLibrary& operator=(const GlfwLibrary&) = delete;
+};
+
+struct GlfwWindow {
+  GLFWwindow* handle = nullptr;
+  GlfwWindow(int width, int height, const char* title) {
+    // VTK's OpenGL2 backend needs a 3.2 core context.
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 2);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_DEPTH_BITS, 24);
+    handle = glfwCreateWindow(width, height, title, nullptr, nullptr);
+    if (!handle) throw std::runtime_error("[sailshape-viewer] cannot create a " + std::to_string(width) + "×" +
+                                          std::to_string(height) + " OpenGL 3.2 window");
+    glfwMakeContextCurrent(handle);
+  }
+  ~GlfwWindow() { glfwDestroyWindow(handle); }
+  GlfwWindow(const GlfwWindow&) = delete;
+  GlfwWindow& operator=(const GlfwWindow&) = delete;
+};
+
+struct ImGuiContextScope {
+  explicit ImGuiContextScope(GLFWwindow* window) {
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // the layout is fixed; nothing to remember
+    if (!ImGui_ImplGlfw_InitForOpenGL(window, true) || !ImGui_ImplOpenGL3_Init("#version 150"))
+      throw std::runtime_error("[sailshape-viewer] cannot initialise Dear ImGui's GLFW/OpenGL3 backends");
+  }
+  ~ImGuiContextScope() {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+  ImGuiContextScope(const ImGuiContextScope&) = delete;
+  ImGuiContextScope& operator=(const ImGuiContextScope&) = delete;
+};
+
+void setStyle() {
+  ImGuiIO& io = ImGui::GetIO();
+  // Latin-1 (°, ², ·), Greek (σ), dashes and the minus sign.
+  static const ImWchar ranges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x2027, 0x2212, 0x2212, 0x25A0, 0x25A0, 0};
+  const char* font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+  if (std::filesystem::exists(font)) io.Fonts->AddFontFromFileTTF(font, 15.0f, nullptr, ranges);
+  ImGui::StyleColorsDark();
+  ImGuiStyle& s = ImGui::GetStyle();
+  s.WindowRounding = 0;
+  s.FrameRounding = 3;
+  s.GrabRounding = 3;
+  s.TabRounding = 3;
+  s.WindowBorderSize = 1;
+  s.FramePadding = ImVec2(6, 3);
+  s.ItemSpacing = ImVec2(8, 5);
+  ImVec4* c = s.Colors;
+  c[ImGuiCol_WindowBg] = ImVec4(0.105f, 0.115f, 0.135f, 1.0f);
+  c[ImGuiCol_ChildBg] = ImVec4(0.085f, 0.095f, 0.110f, 1.0f);
+  c[ImGuiCol_TitleBg] = ImVec4(0.13f, 0.16f, 0.21f, 1.0f);
+  c[ImGuiCol_TitleBgActive] = ImVec4(0.16f, 0.22f, 0.32f, 1.0f);
+  c[ImGuiCol_Header] = ImVec4(0.20f, 0.32f, 0.50f, 0.70f);
+  c[ImGuiCol_HeaderHovered] = ImVec4(0.26f, 0.42f, 0.65f, 0.80f);
+  c[ImGuiCol_Button] = ImVec4(0.20f, 0.30f, 0.45f, 1.0f);
+  c[ImGuiCol_ButtonHovered] = ImVec4(0.27f, 0.42f, 0.62f, 1.0f);
+  c[ImGuiCol_FrameBg] = ImVec4(0.16f, 0.18f, 0.22f, 1.0f);
+  c[ImGuiCol_Tab] = ImVec4(0.15f, 0.20f, 0.28f, 1.0f);
+  c[ImGuiCol_TabActive] = ImVec4(0.22f, 0.34f, 0.52f, 1.0f);
+  c[ImGuiCol_TableRowBgAlt] = ImVec4(1, 1, 1, 0.03f);
+}
+
+// Reads the back buffer (what the frame just drew) and writes it as PNG, top row first.
+void saveScreenshot(const std::string& path, int width, int height) {
+  if (width <= 0 || height <= 0)
+    throw std::runtime_error("[saveScreenshot] the window has no pixels (" + std::to_string(width) + "×" +
+                             std::to_string(height) + ")");
+  std::vector<unsigned char> rgba(static_cast<size_t>(width) * height * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  const size_t row = static_cast<size_t>(width) * 4;
+  std::vector<unsigned char> flipped(rgba.size());
+  for (int y = 0; y < height; ++y)
+    std::copy_n(rgba.data() + row * (height - 1 - y), row, flipped.data() + row * y);
+  for (size_t i = 3; i < flipped.size(); i += 4) flipped[i] = 255;
+  if (!stbi_write_png(path.c_str(), width, height, 4, flipped.data(), static_cast<int>(row)))
+    throw std::runtime_error("[saveScreenshot] cannot write " + path);
+}
+
+// --exercise-window: what a user does to a window, scripted over counted frames
+// (shrink until the 3D view has no pixels, minimise, restore, grow back).
+void exerciseWindow(GLFWwindow* window, int frame, const Options& o) {
+  switch (frame) {
+    case 1: glfwSetWindowSize(window, 640, 400); break;
+    case 4: glfwSetWindowSize(window, 160, 90); break;
+    case 7: glfwIconifyWindow(window); break;
+    case 10: glfwRestoreWindow(window); break;
+    case 13: glfwSetWindowSize(window, o.width, o.height); break;
+    default: break;
+  }
+}
+
+int run(const Options& o) {
+  GlfwLibrary glfw;
+  GlfwWindow window(o.width, o.height, "sailshape viewer");
+  glfwSwapInterval(o.screenshot.empty() ? 1 : 0);
+  ImGuiContextScope imgui(window.handle);
+  setStyle();
+  using BindFramebuffer = void (*)(GLenum, GLuint);
+  const auto bind_framebuffer = reinterpret_cast<BindFramebuffer>(glfwGetProcAddress("glBindFramebuffer"));
+
+  App app(o.database);
+  if (o.deviation) app.setDeviationView(true);
+  const bool shooting = !o.screenshot.empty();
+  int counted = 0;
+  const auto started = std::chrono::steady_clock::now();
+  bool timed_out = false;
+  while (!glfwWindowShouldClose(window.handle)) {
+    if (shooting) glfwPollEvents();
+    else glfwWaitEventsTimeout(app.busy() ? 0.03 : 0.25);
+    int fb_w = 0, fb_h = 0;
+    glfwGetFramebufferSize(window.handle, &fb_w, &fb_h);
+
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    const ImVec2 display = ImGui::GetIO().DisplaySize;
+    app.frame(display.x, display.y);
+    ImGui::Render();
+
+    if (bind_framebuffer) bind_framebuffer(GL_FRAMEBUFFER, 0);  // VTK drew into its own
+    if (fb_w > 0 && fb_h > 0) {
+      glViewport(0, 0, fb_w, fb_h);
+      glClearColor(0.08f, 0.09f, 0.10f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT);
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    }
+
+    if (shooting) {
+      // Frames count once the scan on screen has finished loading, so N frames
+      // always show the same thing however fast the machine is.
+      const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      if (!app.settled() && waited > 300) timed_out = true;
+      if (app.settled() || timed_out) {
+        ++counted;
+        if (o.exercise_window) exerciseWindow(window.handle, counted, o);
+      }
+      if (counted >= o.frames) {
+        saveScreenshot(o.screenshot, fb_w, fb_h);
+        std::cout << "sailshape-viewer: wrote " << o.screenshot << " (" << fb_w << "×" << fb_h << ", " << counted
+                  << " frames)\n";
+        glfwSwapBuffers(window.handle);
+        if (timed_out) {
+          std::cerr << "sailshape-viewer: the scan was still loading after 300 s; the screenshot shows the state then\n";
+          return 1;
+        }
+        return 0;
+      }
+    }
+    glfwSwapBuffers(window.handle);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App cli("sailshape-viewer: design against flying sail shapes from a sailshape database");
+  cli.add_option("database", o.database, "sailshape database file (.sqlite) to open; a missing file is reported, not created");
+  cli.add_option("--screenshot", o.screenshot, "render --frames frames, save a PNG of the whole window to this file and exit");
+  cli.add_option("--frames", o.frames, "frames to render before the screenshot, counted once the first scan has loaded")
+      ->check(CLI::Range(1, 100000));
+  cli.add_option("--width", o.width, "window width in pixels")->check(CLI::Range(160, 8192));
+  cli.add_option("--height", o.height, "window height in pixels")->check(CLI::Range(90, 8192));
+  cli.add_flag("--exercise-window", o.exercise_window,
+               "with --screenshot: resize the window down to a zero-size 3D view, minimise and restore it during the "
+               "frames (needs --frames >= 16)");
+  cli.add_flag("--deviation", o.deviation, "start with the flying shape coloured by signed deviation from the design");
+  try {
+    cli.parse(argc, argv);
+    if (!o.screenshot.empty() && o.frames == 0) throw CLI::ValidationError("--screenshot", "needs --frames N");
+    if (o.screenshot.empty() && (o.frames || o.exercise_window))
+      throw CLI::ValidationError("--frames", "--frames and --exercise-window need --screenshot");
+    if (o.exercise_window && o.frames < 16) throw CLI::ValidationError("--exercise-window", "needs --frames >= 16");
+  } catch (const CLI::ParseError& e) {
+    return cli.exit(e);
+  }
+  try {
+    return run(o);
+  } catch (const std::exception& e) {
+    std::cerr << "sailshape-viewer: " << e.what() << "\n";
+    return 1;
+  }
+}

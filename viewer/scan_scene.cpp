@@ -1,0 +1,84 @@
+#include "viewer/scan_scene.hpp"
+
+#include <numeric>
+
+#include "analysis/errors.hpp"
+#include "viewer/worker.hpp"
+
+namespace sailshape::viewer {
+
+Cloud thinCloud(const Cloud& cloud, size_t max_points) {
+  if (max_points == 0) throw InvalidInput("[thinCloud] max_points must be > 0");
+  if (cloud.size() <= max_points) return cloud;
+  const size_t step = (cloud.size() + max_points - 1) / max_points;
+  std::vector<uint32_t> keep;
+  keep.reserve(cloud.size() / step + 1);
+  for (size_t i = 0; i < cloud.size(); i += step) keep.push_back(static_cast<uint32_t>(i));
+  return selectPoints(cloud, keep);
+}
+
+ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const SceneOptions& options,
+                         const Progress& progress) {
+  ScanScene scene;
+  if (record.cloud) {
+    progress("load cloud", 0.0);
+    scene.raw_cloud = thinCloud(*record.cloud, options.max_cloud_points);
+    if (options.analyze_cloud) {
+      try {
+        scene.analysis = analyzeSail(*record.cloud, options.analysis, progress);
+        scene.surface = scene.analysis->mesh;
+      } catch (const Cancelled&) {
+        throw;
+      } catch (const std::exception& e) {
+        scene.warnings.push_back(std::string("flying surface: the pipeline failed on the stored cloud: ") + e.what());
+      }
+    }
+    record.cloud.reset();
+  } else {
+    scene.warnings.push_back("the scan has no stored cloud: sections only");
+  }
+  scene.sections = record.sections;
+  if (scene.sections.sections.empty() && scene.analysis) scene.sections = scene.analysis->sections;
+  scene.record = std::move(record);
+
+  if (!design || design->empty()) {
+    if (scene.record.has_design) scene.warnings.push_back("the design mesh could not be read");
+    return scene;
+  }
+  scene.design = std::move(*design);
+  try {
+    const DesignDistance distance(scene.design);
+    if (!scene.surface.empty()) {
+      scene.surface_deviation_m = signedDistances(distance, scene.surface.vertices, progress);
+      scene.deviation = distanceStats(scene.surface_deviation_m);
+    }
+    if (!scene.raw_cloud.empty()) {
+      scene.raw_deviation_m = signedDistances(distance, scene.raw_cloud.points, progress);
+      if (!scene.deviation) scene.deviation = distanceStats(scene.raw_deviation_m);
+    }
+    for (const auto& w : distance.warnings()) scene.warnings.push_back("design: " + w);
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const std::exception& e) {
+    scene.warnings.push_back(std::string("deviation from design: ") + e.what());
+  }
+
+  if (options.design_sections && !scene.sections.sections.empty()) {
+    progress("design sections", 0.0);
+    try {
+      SectionParams sp;
+      for (const auto& s : scene.sections.sections) sp.fractions.push_back(s.fraction);
+      const MeshSections ms = analyzeMeshSections(scene.design, OutlineParams{}, sp);
+      scene.design_sections = ms.sections;
+      scene.deltas = sectionDeltas(scene.design_sections, scene.sections);
+    } catch (const Cancelled&) {
+      throw;
+    } catch (const std::exception& e) {
+      scene.warnings.push_back(std::string("design sections: ") + e.what());
+    }
+  }
+  progress("done", 1.0);
+  return scene;
+}
+
+}  // namespace sailshape::viewer

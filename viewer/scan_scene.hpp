@@ -1,0 +1,48 @@
+#pragma once
+// What the 3D view and the panels show for one scan, computed off the UI
+// thread: the flying surface (the pipeline run on the stored cloud), its signed
+// deviation from the sail's design, and the design's sections at the flying
+// sections' fractions.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/design_compare.hpp"
+#include "analysis/pipeline.hpp"
+#include "database/scan_record.hpp"
+
+namespace sailshape::viewer {
+
+struct SceneOptions {
+  bool analyze_cloud = true;      // run the pipeline on the stored cloud for the flying surface
+  AnalysisParams analysis;        // the pipeline's parameters for that run
+  bool design_sections = true;    // cut the design at the flying fractions (needed for the section table)
+  size_t max_cloud_points = 300'000;  // the raw cloud is thinned (every k-th point) above this for display
+};
+
+struct ScanScene {
+  ScanRecord record;              // its cloud is moved to raw_cloud
+  Cloud raw_cloud;                // as stored (thinned for display), boat frame, metres
+  std::vector<double> raw_deviation_m;      // per raw_cloud point; empty without a design
+  std::optional<SailAnalysis> analysis;     // the pipeline's run on the stored cloud
+  Mesh surface;                   // flying surface (the analysis mesh); empty when unavailable
+  std::vector<double> surface_deviation_m;  // per surface vertex; empty without a design
+  // The stored sections, or the fresh analysis's when the scan has none stored.
+  SectionAnalysis sections;
+  Mesh design;                    // empty when the sail has no design mesh
+  SectionAnalysis design_sections;          // at the fractions of `sections`
+  std::vector<SectionDelta> deltas;         // flying − design, per section
+  std::optional<DistanceStats> deviation;   // of the surface (or the raw cloud without one)
+  std::vector<std::string> warnings;        // what could not be computed, and why
+};
+
+// Never throws for missing parts (no cloud, no design, a pipeline stage that
+// fails): those become warnings and empty members. Throws Cancelled (worker.hpp)
+// when the progress callback does.
+ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const SceneOptions& options = {},
+                         const Progress& progress = {});
+
+// Every k-th point so that at most `max_points` remain (attributes kept).
+Cloud thinCloud(const Cloud& cloud, size_t max_points);
+
+}  // namespace sailshape::viewer
