@@ -12,6 +12,7 @@
 #include "database/catalog.hpp"
 #include "database/scan_record.hpp"
 #include "database/schema.hpp"
+#include "reports/trim_report.hpp"
 
 namespace sailshape::viewer {
 namespace {
@@ -173,11 +174,45 @@ App::App(std::optional<std::string> database_path) : viewport_(std::make_unique<
 App::~App() {
   load_.task.cancel();
   processing_.task.cancel();
+  report_.task.cancel();
   load_.task.wait();
   processing_.task.wait();
+  report_.task.wait();
 }
 
-bool App::busy() const { return load_.task.busy() || processing_.task.busy(); }
+bool App::startReport(const std::string& out_path, bool whole_test, const std::string& audience) {
+  if (!database_.db || !load_.scene) {
+    log_.error("report: select a scan first");
+    return false;
+  }
+  if (report_.task.busy()) {
+    log_.error("report: a report is still being written");
+    return false;
+  }
+  if (out_path.empty()) {
+    log_.error("report: give the PDF's path");
+    return false;
+  }
+  TrimReportParams params;
+  params.db_path = database_.path;
+  params.out_path = out_path;
+  params.audience = audience;
+  const ScanRecord& r = load_.scene->record;
+  if (whole_test && !r.test.empty()) {
+    params.test = r.test;
+    params.sail = r.sail;
+  } else {
+    params.scan_id = r.scan_id;
+  }
+  report_.note.clear();
+  report_.task.start("report " + out_path, [params](const Progress& p) {
+    const TrimReport report = writeTrimReport(params, p);
+    return "wrote " + report.out_path + " (" + std::to_string(report.pages) + " pages)";
+  });
+  return true;
+}
+
+bool App::busy() const { return load_.task.busy() || processing_.task.busy() || report_.task.busy(); }
 
 bool App::settled() const {
   return initial_load_done_ && !busy() && load_.pending_scan == 0 && load_.loading_scan == 0 &&
@@ -285,6 +320,19 @@ void App::pollJobs() {
   }
   startNextLoad();
 
+  const JobStatus rs = report_.task.status();
+  if (rs.state != JobState::Running && rs.state != JobState::Idle && report_.note.empty()) {
+    if (auto written = report_.task.take()) {
+      report_.note = *written;
+      log_.info(*written);
+    } else if (rs.state == JobState::Failed) {
+      report_.note = rs.error;
+      log_.error("report: " + rs.error);
+    } else {
+      report_.note = "report cancelled";
+    }
+  }
+
   const JobStatus ps = processing_.task.status();
   if (ps.state != JobState::Running && ps.state != JobState::Idle) {
     if (auto r = processing_.task.take()) {
@@ -348,12 +396,19 @@ void App::drawToolbar(float x, float y, float w, float h) {
       if (ImGui::Button(label)) view_.camera = preset;
     }
     ImGui::SameLine(0, 24);
-    // reports/ (the PDF writer) has not landed: the button says so instead of pretending.
-    ImGui::BeginDisabled();
-    ImGui::Button("Report (PDF)");
+    ImGui::BeginDisabled(!load_.scene || report_.task.busy());
+    if (ImGui::Button(report_.task.busy() ? "Writing report…" : "Report (PDF)")) {
+      report_.popup = true;
+      const ScanRecord& r = load_.scene->record;
+      const auto dir = std::filesystem::path(database_.path).parent_path();
+      std::snprintf(report_.out_path, sizeof report_.out_path, "%s",
+                    (dir / ("report-scan-" + std::to_string(r.scan_id) + ".pdf")).c_str());
+      ImGui::OpenPopup("Trim report");
+    }
     ImGui::EndDisabled();
     if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
-      ImGui::SetTooltip("Not available in this build: the PDF report module (reports/) is not part of it yet.");
+      ImGui::SetTooltip("PDF trim report of the selected scan or of its test (as `sailshape report`)");
+    drawReportPopup();
   }
   ImGui::End();
   ImGui::PopStyleVar();
@@ -895,11 +950,40 @@ void App::drawScanner() {
   ImGui::EndDisabled();
 }
 
+void App::drawReportPopup() {
+  if (!ImGui::BeginPopupModal("Trim report", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+  ImGui::Text("PDF trim report");
+  ImGui::RadioButton("this scan", !report_.whole_test);
+  if (ImGui::IsItemClicked()) report_.whole_test = false;
+  ImGui::SameLine();
+  ImGui::RadioButton("every trim step of its test", report_.whole_test);
+  if (ImGui::IsItemClicked()) report_.whole_test = true;
+  ImGui::RadioButton("for the crew", report_.audience == 0);
+  if (ImGui::IsItemClicked()) report_.audience = 0;
+  ImGui::SameLine();
+  ImGui::RadioButton("for the designer", report_.audience == 1);
+  if (ImGui::IsItemClicked()) report_.audience = 1;
+  ImGui::SetNextItemWidth(420);
+  ImGui::InputText("file", report_.out_path, sizeof report_.out_path);
+  if (ImGui::Button("Write", ImVec2(120, 0))) {
+    startReport(report_.out_path, report_.whole_test, report_.audience == 0 ? "crew" : "designer");
+    ImGui::CloseCurrentPopup();
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("Close", ImVec2(120, 0))) ImGui::CloseCurrentPopup();
+  ImGui::EndPopup();
+}
+
 void App::drawStatus(float x, float y, float w, float h) {
   ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(8, 4));
   if (begin("##status", x, y, w, h, ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar)) {
     const JobStatus st = load_.task.status();
-    if (st.state == JobState::Running) {
+    const JobStatus rs = report_.task.status();
+    if (rs.state == JobState::Running) {
+      ImGui::Text("writing %s", rs.name.c_str() + 7);
+      ImGui::SameLine();
+      ImGui::ProgressBar(static_cast<float>(rs.fraction), ImVec2(220, 0), rs.stage.c_str());
+    } else if (st.state == JobState::Running) {
       ImGui::Text("%s", st.name.c_str());
       ImGui::SameLine();
       ImGui::ProgressBar(static_cast<float>(st.fraction), ImVec2(220, 0), st.stage.c_str());

@@ -74,6 +74,16 @@ struct ViewState {
   bool hovered = false;
 };
 
+// The Report button: a PDF of the selected scan or of its test (reports/trim_report.hpp).
+struct ReportState {
+  Task<std::string> task;           // result: what was written
+  bool popup = false;
+  bool whole_test = false;
+  int audience = 1;                 // 0 crew, 1 designer
+  char out_path[1024] = {};
+  std::string note;
+};
+
 struct MessageLog {
   std::vector<std::string> lines;   // newest last
   void info(const std::string& text);
@@ -93,6 +103,9 @@ class App {
   bool settled() const;
   const MessageLog& log() const { return log_; }
   bool databaseOpen() const { return database_.db.has_value(); }
+  // Writes the PDF report of the selected scan (or its whole test) on the worker; false when
+  // there is no scan to report on (the reason goes to the message log).
+  bool startReport(const std::string& out_path, bool whole_test, const std::string& audience);
   void setDeviationView(bool on) {
     view_.options.deviation = on;
     view_.rebuild = true;
@@ -113,6 +126,7 @@ class App {
   void drawTrimComparison();
   void drawProcessing();
   void drawScanner();
+  void drawReportPopup();
   void drawStatus(float x, float y, float w, float h);
   std::vector<Overlay> overlayList() const;
 
@@ -123,6 +137,7 @@ class App {
   PickState pick_;
   PlotState plots_;
   ViewState view_;
+  ReportState report_;
   MessageLog log_;
   std::unique_ptr<VtkViewport> viewport_;
   bool initial_load_done_ = false;

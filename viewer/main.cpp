@@ -30,6 +30,7 @@ struct Options {
   int width = 1600, height = 1000;
   bool exercise_window = false;
   bool deviation = false;
+  std::string report;  // --report: write this PDF once the first scan is loaded (scripted Report button)
 };
 
 // GLFW for the process: initialised once, terminated on scope exit.
@@ -153,6 +154,7 @@ int run(const Options& o) {
   if (o.deviation) app.setDeviationView(true);
   const bool shooting = !o.screenshot.empty();
   int counted = 0;
+  bool report_started = o.report.empty();
   const auto started = std::chrono::steady_clock::now();
   bool timed_out = false;
   while (!glfwWindowShouldClose(window.handle)) {
@@ -181,6 +183,11 @@ int run(const Options& o) {
       // always show the same thing however fast the machine is.
       const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       if (!app.settled() && waited > 300) timed_out = true;
+      if (!report_started && app.settled()) {
+        report_started = true;
+        if (!app.startReport(o.report, false, "designer")) return 1;
+        continue;  // count frames once the report is written
+      }
       if (app.settled() || timed_out) {
         ++counted;
         if (o.exercise_window) exerciseWindow(window.handle, counted, o);
@@ -216,12 +223,15 @@ int main(int argc, char** argv) {
   cli.add_flag("--exercise-window", o.exercise_window,
                "with --screenshot: resize the window down to a zero-size 3D view, minimise and restore it during the "
                "frames (needs --frames >= 16)");
+  cli.add_option("--report", o.report,
+                 "with --screenshot: once the first scan is loaded, write its PDF trim report (designer) here, as the "
+                 "Report button does, before counting frames");
   cli.add_flag("--deviation", o.deviation, "start with the flying shape coloured by signed deviation from the design");
   try {
     cli.parse(argc, argv);
     if (!o.screenshot.empty() && o.frames == 0) throw CLI::ValidationError("--screenshot", "needs --frames N");
-    if (o.screenshot.empty() && (o.frames || o.exercise_window))
-      throw CLI::ValidationError("--frames", "--frames and --exercise-window need --screenshot");
+    if (o.screenshot.empty() && (o.frames || o.exercise_window || !o.report.empty()))
+      throw CLI::ValidationError("--frames", "--frames, --exercise-window and --report need --screenshot");
     if (o.exercise_window && o.frames < 16) throw CLI::ValidationError("--exercise-window", "needs --frames >= 16");
   } catch (const CLI::ParseError& e) {
     return cli.exit(e);

@@ -189,11 +189,27 @@ TEST_F(ViewerApp, AMissingFileIsReportedAndNotCreated) {
   EXPECT_GT(count(img, kBrowser, kErrorText), 30u) << "and in the browser";
 }
 
+TEST_F(ViewerApp, ReportButtonWritesThePdfOfTheShownScan) {
+  const std::string pdf = dir_->file("report.pdf");
+  const std::string png = dir_->file("report.png");
+  const ViewerRun r = runViewer(*dir_, quote(dir_->file("sails.sqlite")) + " --report " + quote(pdf) +
+                                           " --screenshot " + quote(png) + " --frames 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const std::string bytes = slurp(pdf);
+  ASSERT_GT(bytes.size(), 10'000u) << "no report at " << pdf;
+  EXPECT_EQ(bytes.substr(0, 5), "%PDF-");
+  EXPECT_NE(bytes.find("%%EOF", bytes.size() - 32), std::string::npos) << "the PDF is complete";
+}
+
 TEST_F(ViewerApp, RefusesBadOptions) {
   const ViewerRun no_frames = runViewer(*dir_, "--screenshot " + quote(dir_->file("x.png")));
   EXPECT_NE(no_frames.exit_code, 0);
   EXPECT_NE(no_frames.err.find("--frames"), std::string::npos) << no_frames.err;
   EXPECT_FALSE(std::filesystem::exists(dir_->file("x.png")));
+  const ViewerRun report_alone = runViewer(*dir_, "--report " + quote(dir_->file("x.pdf")));
+  EXPECT_NE(report_alone.exit_code, 0);
+  EXPECT_NE(report_alone.err.find("--screenshot"), std::string::npos) << report_alone.err;
 }
 
 }  // namespace
