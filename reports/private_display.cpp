@@ -1,5 +1,6 @@
 #include "reports/private_display.hpp"
 
+#include <X11/Xlib.h>
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -29,16 +30,27 @@ std::string findOnPath(const std::string& program) {
   return {};
 }
 
+bool displayOpens(const std::string& display) {
+  if (display.empty()) return false;
+  Display* x = XOpenDisplay(display.c_str());
+  if (!x) return false;
+  XCloseDisplay(x);
+  return true;
+}
+
 PrivateDisplay::PrivateDisplay(int timeout_ms) {
   const char* current = std::getenv("DISPLAY");
-  if (current && *current) {
-    display_ = current;
+  had_previous_ = current != nullptr;
+  if (current) previous_ = current;
+  if (displayOpens(previous_)) {
+    display_ = previous_;
     return;
   }
   const std::string xvfb = findOnPath("Xvfb");
   if (xvfb.empty())
-    throw DisplayError("[PrivateDisplay] no DISPLAY is set and Xvfb is not installed (apt install xvfb): "
-                       "the report's 3D views need an X display");
+    throw DisplayError(std::string("[PrivateDisplay] ") +
+                       (previous_.empty() ? "no DISPLAY is set" : "DISPLAY " + previous_ + " cannot be opened") +
+                       " and Xvfb is not installed (apt install xvfb): the report's 3D views need an X display");
   // Xvfb writes the display number it picked to this pipe once it accepts clients.
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0)
@@ -97,7 +109,8 @@ PrivateDisplay::PrivateDisplay(int timeout_ms) {
 
 PrivateDisplay::~PrivateDisplay() {
   if (pid_ <= 0) return;
-  unsetenv("DISPLAY");
+  if (had_previous_) setenv("DISPLAY", previous_.c_str(), 1);
+  else unsetenv("DISPLAY");
   kill(pid_, SIGTERM);
   waitpid(pid_, nullptr, 0);
 }

@@ -390,8 +390,25 @@ TEST(PrivateDisplay, StartsXvfbWithoutDisplayAndStopsIt) {
     ASSERT_NE(std::getenv("DISPLAY"), nullptr);
     EXPECT_EQ(display.display(), std::getenv("DISPLAY"));
     EXPECT_EQ(display.display()[0], ':');
+    PrivateDisplay reuse;  // a display that opens is used as it is
+    EXPECT_FALSE(reuse.started());
+    EXPECT_EQ(reuse.display(), display.display());
   }
   EXPECT_EQ(std::getenv("DISPLAY"), nullptr);
+}
+
+TEST(PrivateDisplay, ReplacesADisplayThatDoesNotOpenAndRestoresIt) {
+  setenv("DISPLAY", ":987", 1);  // no X server there
+  ASSERT_FALSE(displayOpens(":987"));
+  {
+    PrivateDisplay display;
+    EXPECT_TRUE(display.started());
+    EXPECT_NE(display.display(), ":987");
+    EXPECT_TRUE(displayOpens(display.display()));
+  }
+  ASSERT_NE(std::getenv("DISPLAY"), nullptr);
+  EXPECT_STREQ(std::getenv("DISPLAY"), ":987");
+  unsetenv("DISPLAY");
 }
 
 TEST(PrivateDisplay, FailsWithOneClearLineWhenXvfbIsMissing) {
