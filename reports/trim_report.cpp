@@ -227,8 +227,10 @@ void coverPage(PdfDocument& pdf, Pages& pages, const TrimReportData& r, bool cre
       {"Session", d.session},
       {"Date", date.empty() ? "not recorded" : date},
   };
-  if (!d.test.empty()) rows.push_back({"Test", d.test + " · " + std::to_string(d.steps.size()) + " trim step" +
-                                               (d.steps.size() > 1 ? "s" : "")});
+  if (!d.test.empty())
+    rows.push_back({"Test", d.test + " · " +
+                                (d.steps.size() > 1 ? std::to_string(d.steps.size()) + " trim steps"
+                                                    : "trim step " + std::to_string(d.steps.front().step_order))});
   for (const ReportStep& s : d.steps) {
     std::string forces;
     if (s.drive_n) forces += ", drive " + fmt("%.0f N", *s.drive_n);

@@ -317,6 +317,7 @@ TEST(TrimReport, SingleScanReport) {
   const auto& s = fixture().docs[1]["sections"][7];
   EXPECT_NE(text.find(fmt("%.1f", s["twist_deg"].get<double>()) + " ± 0.2"), std::string::npos);
   EXPECT_EQ(text.find("what changed"), std::string::npos);
+  EXPECT_NE(text.find(std::string(kTest) + " · trim step 2"), std::string::npos);
 }
 
 TEST(TrimReport, BadRequestsThrowAndLeaveAnExistingFileAlone) {
