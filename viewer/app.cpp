@@ -12,6 +12,7 @@
 #include "database/catalog.hpp"
 #include "database/scan_record.hpp"
 #include "database/schema.hpp"
+#include "acquisition/scene.hpp"
 #include "reports/trim_report.hpp"
 
 namespace sailshape::viewer {
@@ -175,6 +176,10 @@ App::~App() {
   load_.task.cancel();
   processing_.task.cancel();
   report_.task.cancel();
+  scanner_.scan_task.cancel();
+  scanner_.home_task.cancel();
+  scanner_.scan_task.wait();
+  scanner_.home_task.wait();
   load_.task.wait();
   processing_.task.wait();
   report_.task.wait();
@@ -212,7 +217,10 @@ bool App::startReport(const std::string& out_path, bool whole_test, const std::s
   return true;
 }
 
-bool App::busy() const { return load_.task.busy() || processing_.task.busy() || report_.task.busy(); }
+bool App::busy() const {
+  return load_.task.busy() || processing_.task.busy() || report_.task.busy() || scanner_.scan_task.busy() ||
+         scanner_.home_task.busy();
+}
 
 bool App::settled() const {
   return initial_load_done_ && !busy() && load_.pending_scan == 0 && load_.loading_scan == 0 &&
@@ -331,6 +339,33 @@ void App::pollJobs() {
     } else {
       report_.note = "report cancelled";
     }
+  }
+
+  const JobStatus ss = scanner_.scan_task.status();
+  if (ss.state != JobState::Running && ss.state != JobState::Idle) {
+    if (auto a = scanner_.scan_task.take()) {
+      scanner_.note = std::to_string(a->cloud.size()) + " points from " + std::to_string(a->sweeps.size()) + " unit(s)";
+      for (size_t i = 0; i < a->errors.size(); ++i)
+        if (!a->errors[i].empty()) log_.error("unit " + std::to_string(i + 1) + ": " + a->errors[i]);
+      for (const auto& w : a->warnings) log_.info(w);
+      StageResult preview;
+      preview.cloud = thinCloud(a->cloud, 300'000);
+      scanner_.preview = std::move(preview);
+      scanner_.last = std::move(*a);
+      view_.rebuild = true;
+    } else if (ss.state == JobState::Failed && scanner_.note != ss.error) {
+      scanner_.note = ss.error;
+      log_.error("scan: " + ss.error);
+    } else if (ss.state == JobState::Cancelled && scanner_.note != "scan cancelled") {
+      scanner_.note = "scan cancelled";
+    }
+  }
+  const JobStatus hs = scanner_.home_task.status();
+  if (hs.state == JobState::Succeeded) {
+    if (auto h = scanner_.home_task.take()) scanner_.note = *h;
+  } else if (hs.state == JobState::Failed && scanner_.note != hs.error) {
+    scanner_.note = hs.error;
+    log_.error("home: " + hs.error);
   }
 
   const JobStatus ps = processing_.task.status();
@@ -507,8 +542,9 @@ void App::drawView(float x, float y, float w, float h) {
     const ImVec2 avail = ImGui::GetContentRegionAvail();
     const int vw = static_cast<int>(avail.x), vh = static_cast<int>(avail.y);
     if (view_.rebuild) {
-      const StageResult* proc = processing_.show_result && processing_.result &&
-                                        processing_.result_scan == browser_.selected_scan
+      const StageResult* proc = scanner_.preview                                          ? &*scanner_.preview
+                                : processing_.show_result && processing_.result &&
+                                          processing_.result_scan == browser_.selected_scan
                                     ? &*processing_.result
                                     : nullptr;
       viewport_->setScene(load_.scene ? &*load_.scene : nullptr, overlayList(), view_.options, proc);
@@ -934,20 +970,142 @@ void App::drawProcessing() {
 }
 
 void App::drawScanner() {
-  ImGui::TextColored(kAccentText, "Scanners");
-  ImGui::TextWrapped("Not available in this build: the acquisition module (scanner client and emulator, "
-                     "acquisition/) is not part of it yet. The controls below are placeholders and do nothing.");
-  ImGui::BeginDisabled();
-  char unit_file[8] = {};
-  ImGui::InputText("unit file", unit_file, sizeof unit_file);
-  ImGui::Button("Connect");
+  ScannerState& sc = scanner_;
+  const bool running = sc.scan_task.busy() || sc.home_task.busy();
+  ImGui::BeginDisabled(running);
+  ImGui::SetNextItemWidth(-90);
+  ImGui::InputTextWithHint("##unit", "UNIT.json", sc.unit_path, sizeof sc.unit_path);
   ImGui::SameLine();
-  ImGui::Button("Home");
+  if (ImGui::Button("Load unit")) {
+    try {
+      sc.session.addUnitFile(sc.unit_path);
+      sc.note = "loaded " + std::string(sc.unit_path);
+    } catch (const std::exception& e) {
+      sc.note = e.what();
+      log_.error(e.what());
+    }
+  }
+  if (ImGui::Button("Add emulated unit (deck scene)")) {
+    try {
+      sc.session.addEmulatedUnit(builtInDeckScene(), "deck", deckUnit());
+      sc.note = "emulated unit on " + sc.session.units().back().config.serial_device + " and port " +
+                std::to_string(sc.session.units().back().config.port);
+    } catch (const std::exception& e) {
+      sc.note = e.what();
+      log_.error(e.what());
+    }
+  }
+  std::optional<size_t> remove, home;
+  for (size_t i = 0; i < sc.session.units().size(); ++i) {
+    ScannerUnitSlot& u = sc.session.units()[i];
+    ImGui::PushID(static_cast<int>(i));
+    ImGui::Separator();
+    ImGui::TextColored(kAccentText, "%s", u.config.name.c_str());
+    ImGui::SameLine();
+    ImGui::TextColored(kMutedText, "%s · %s:%u · %s", u.origin.c_str(), u.config.host.c_str(), u.config.port,
+                       u.config.serial_device.c_str());
+    ImGui::PushItemWidth(110);
+    inputDouble("speed °/s", &u.config.speed_deg_s, 1, "%.1f");
+    ImGui::SameLine();
+    inputDouble("accel. °/s²", &u.config.acceleration_deg_s2, 10, "%.0f");
+    inputDouble("start °", &u.config.start_angle_deg, 1, "%.1f");
+    ImGui::SameLine();
+    inputDouble("sweep °", &u.config.sweep_angle_deg, 1, "%.1f");
+    ImGui::PopItemWidth();
+    if (ImGui::Button("Home")) home = i;
+    ImGui::SameLine();
+    if (ImGui::Button("Remove")) remove = i;
+    ImGui::PopID();
+  }
+  if (remove) sc.session.removeUnit(*remove);
+  if (home) {
+    const size_t index = *home;
+    const ScannerSession* session = &sc.session;
+    sc.home_task.start("home unit " + std::to_string(index + 1), [session, index](const Progress&) {
+      session->home(index);
+      return std::string("unit ") + std::to_string(index + 1) + " homed";
+    });
+  }
+  ImGui::Separator();
+  ImGui::TextColored(kAccentText, "Trim step");
+  ImGui::PushItemWidth(170);
+  ImGui::InputText("campaign", sc.campaign, sizeof sc.campaign);
+  ImGui::InputText("session", sc.session_name, sizeof sc.session_name);
+  ImGui::InputText("sail", sc.sail, sizeof sc.sail);
+  ImGui::InputText("test", sc.test, sizeof sc.test);
+  inputInt("step", &sc.step, 0, 100000);
+  ImGui::Checkbox("##awa", &sc.has_awa);
   ImGui::SameLine();
-  ImGui::Button("Scan");
+  inputDouble("AWA °", &sc.awa_deg, 1, "%.1f");
+  ImGui::Checkbox("##aws", &sc.has_aws);
   ImGui::SameLine();
-  ImGui::Button("Live");
+  inputDouble("AWS m/s", &sc.aws_m_s, 0.5, "%.1f");
+  ImGui::Checkbox("##forces", &sc.has_forces);
+  ImGui::SameLine();
+  inputDouble("drive N", &sc.drive_n, 10, "%.0f");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(90);
+  inputDouble("side N", &sc.side_n, 10, "%.0f");
+  ImGui::InputTextWithHint("controls", "sheet=0.42; traveller=-0.1", sc.controls, sizeof sc.controls);
+  ImGui::PopItemWidth();
+  ImGui::BeginDisabled(sc.session.units().empty());
+  if (ImGui::Button("Scan", ImVec2(120, 0))) {
+    sc.last.reset();
+    sc.preview.reset();
+    view_.rebuild = true;
+    const ScannerSession* session = &sc.session;
+    sc.scan_task.start("scan", [session](const Progress& p) { return session->scan({}, p); });
+  }
   ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!sc.last || !database_.db);
+  if (ImGui::Button("Save to database", ImVec2(160, 0))) {
+    try {
+      TrimStepForm form;
+      form.campaign = sc.campaign;
+      form.session = sc.session_name;
+      form.sail = sc.sail;
+      form.test = sc.test;
+      form.step = sc.step;
+      if (sc.has_awa) form.awa_deg = sc.awa_deg;
+      if (sc.has_aws) form.aws_m_s = sc.aws_m_s;
+      if (sc.has_forces) {
+        form.drive_n = sc.drive_n;
+        form.side_n = sc.side_n;
+      }
+      form.controls = sc.controls;
+      const ImportResult saved = saveAcquisition(*database_.db, *sc.last, form);
+      sc.note = "saved as scan " + std::to_string(saved.scan_id);
+      log_.info(sc.note);
+      sc.last.reset();
+      sc.preview.reset();
+      browser_.tree = loadCatalogTree(*database_.db);
+      selectScan(saved.scan_id);
+      view_.rebuild = true;
+    } catch (const std::exception& e) {
+      sc.note = e.what();
+      log_.error(e.what());
+    }
+  }
+  ImGui::EndDisabled();
+  ImGui::EndDisabled();
+  if (running) {
+    const JobStatus st = sc.scan_task.busy() ? sc.scan_task.status() : sc.home_task.status();
+    ImGui::ProgressBar(static_cast<float>(st.fraction), ImVec2(-80, 0), st.stage.empty() ? st.name.c_str() : st.stage.c_str());
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel")) {
+      sc.scan_task.cancel();
+      sc.home_task.cancel();
+    }
+  }
+  if (!sc.note.empty()) ImGui::TextWrapped("%s", sc.note.c_str());
+  if (sc.preview) {
+    if (ImGui::Button("Hide the scan from the 3D view")) {
+      sc.preview.reset();
+      view_.rebuild = true;
+    }
+  }
+  ImGui::TextColored(kMutedText, "Live mode (sweep after sweep, analysed as they come) is not in this build.");
 }
 
 void App::drawReportPopup() {

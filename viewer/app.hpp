@@ -15,6 +15,7 @@
 #include "database/sqlite.hpp"
 #include "viewer/catalog_tree.hpp"
 #include "viewer/processing.hpp"
+#include "viewer/scanner_session.hpp"
 #include "viewer/scan_scene.hpp"
 #include "viewer/section_table.hpp"
 #include "viewer/vtk_viewport.hpp"
@@ -84,6 +85,22 @@ struct ReportState {
   std::string note;
 };
 
+// The scanner panel: units, one scan of all of them, the trim-step data, saving.
+struct ScannerState {
+  ScannerSession session;
+  char unit_path[1024] = {};
+  char campaign[128] = "default", session_name[128] = "default", sail[128] = "default", test[128] = {},
+       controls[256] = {};
+  int step = 0;
+  bool has_awa = false, has_aws = false, has_forces = false;
+  double awa_deg = 30, aws_m_s = 5, drive_n = 0, side_n = 0;
+  Task<Acquisition> scan_task;
+  Task<std::string> home_task;
+  std::optional<Acquisition> last;       // the latest scan, not yet saved
+  std::optional<StageResult> preview;    // its cloud, shown in the 3D view
+  std::string note;
+};
+
 struct MessageLog {
   std::vector<std::string> lines;   // newest last
   void info(const std::string& text);
@@ -138,6 +155,7 @@ class App {
   PlotState plots_;
   ViewState view_;
   ReportState report_;
+  ScannerState scanner_;
   MessageLog log_;
   std::unique_ptr<VtkViewport> viewport_;
   bool initial_load_done_ = false;
