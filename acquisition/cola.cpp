@@ -221,7 +221,7 @@ std::string_view ColaReader::takeToken(const char* field) {
   while (pos_ < data_.size() && data_[pos_] == ' ') ++pos_;
   if (pos_ >= data_.size()) fail(field, "telegram ends before this field");
   const size_t end = std::min(data_.find(' ', pos_), data_.size());
-  std::string_view token = data_.substr(pos_, end - pos_);
+  std::string_view token = std::string_view(data_).substr(pos_, end - pos_);
   pos_ = end;
   return token;
 }

@@ -92,7 +92,8 @@ class ColaWriter {
 };
 
 // Reads telegram arguments field by field. Every read names its field so that a truncated or malformed
-// telegram fails with "[<context>] <field>: ..." (ColaError).
+// telegram fails with "[<context>] <field>: ..." (ColaError). The reader keeps its own copy of the
+// arguments, so it may outlive the telegram it was made from.
 class ColaReader {
  public:
   ColaReader(ColaDialect dialect, std::string_view arguments, std::string context);
@@ -115,7 +116,7 @@ class ColaReader {
   std::string_view takeToken(const char* field);
   [[noreturn]] void fail(const char* field, const std::string& what) const;
   ColaDialect dialect_;
-  std::string_view data_;
+  std::string data_;
   size_t pos_ = 0;
   std::string context_;
 };
