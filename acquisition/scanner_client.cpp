@@ -279,6 +279,16 @@ ScannerStartup ScannerClient::start() {
   impl_->closeSocket();
   impl_->pending_scans.clear();
   impl_->connectTo(params_);
+  try {
+    return startupSequence();
+  } catch (...) {
+    // A half-configured device is left alone: the connection closes, the caller may reconnect().
+    impl_->closeSocket();
+    throw;
+  }
+}
+
+ScannerStartup ScannerClient::startupSequence() {
   const ColaDialect d = params_.dialect;
   const std::string& where = impl_->where;
   ScannerStartup out;

@@ -99,7 +99,7 @@ class ScannerClient {
   ScannerClient& operator=(const ScannerClient&) = delete;
 
   // Connects and runs the start-up sequence. Throws ScannerError (refused connection, refused login,
-  // device error state, wrong or missing reply, timeout).
+  // device error state, wrong or missing reply, timeout); the connection is closed then.
   ScannerStartup start();
   // Sends the stop sequence and closes. Throws ScannerError when a reply is wrong or missing.
   void stop();
@@ -123,6 +123,7 @@ class ScannerClient {
   const ScannerClientParams& params() const { return params_; }
 
  private:
+  ScannerStartup startupSequence();
   struct Impl;
   ScannerClientParams params_;
   std::unique_ptr<Impl> impl_;

@@ -382,6 +382,7 @@ TEST(ScannerClient, RefusedLoginIsAClearError) {
   } catch (const ScannerError& e) {
     EXPECT_NE(std::string(e.what()).find("refused the login"), std::string::npos) << e.what();
   }
+  EXPECT_FALSE(client.connected());
 }
 
 TEST(ScannerClient, ScannerThatNeverAnswersTimesOut) {
