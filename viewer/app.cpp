@@ -617,7 +617,7 @@ void App::drawView(float x, float y, float w, float h) {
                                        std::to_string(ov.scene->record.scan_id));
         if (load_.scene->deviation) {
           const DistanceStats& d = *load_.scene->deviation;
-          const std::string line = "deviation: mean " + format("%+.0f", 1000 * d.mean_m) + " mm, rms " +
+          const std::string line = "deviation from design (+ to leeward): mean " + format("%+.0f", 1000 * d.mean_m) + " mm, rms " +
                                    format("%.0f", 1000 * d.rms_m) + " mm, max |" + format("%.0f", 1000 * d.max_abs_m) + "| mm";
           dl->AddText(ImVec2(origin.x + 12, ty + 4), IM_COL32(200, 205, 215, 255), line.c_str());
           ty += 22;
@@ -641,8 +641,9 @@ void App::drawView(float x, float y, float w, float h) {
         dl->AddRectFilled(ImVec2(at.x - 6, at.y - 4), ImVec2(at.x + ts.x + 6, at.y + ts.y + 4), IM_COL32(0, 0, 0, 170), 4);
         dl->AddText(at, IM_COL32(255, 240, 120, 255), text.c_str());
       }
-      dl->AddText(ImVec2(origin.x + avail.x - 330, origin.y + avail.y - 20), IM_COL32(150, 155, 165, 255),
-                  "drag: rotate · right/wheel: zoom · middle: pan · click: pick");
+      const char* hint = "drag: rotate · right/wheel: zoom · middle: pan · click: pick";
+      dl->AddText(ImVec2(origin.x + avail.x - ImGui::CalcTextSize(hint).x - 10, origin.y + avail.y - 20),
+                  IM_COL32(150, 155, 165, 255), hint);
     }
   }
   ImGui::End();

@@ -263,7 +263,7 @@ VtkViewport::VtkViewport() : impl_(std::make_unique<Impl>()) {
   m.scalar_lut->Build();
 
   m.scalar_bar->SetLookupTable(m.deviation_lut);
-  m.scalar_bar->SetTitle("deviation mm (+ leeward)");
+  m.scalar_bar->SetTitle("mm");
   m.scalar_bar->SetNumberOfLabels(5);
   m.scalar_bar->SetLabelFormat("%+.0f");
   m.scalar_bar->SetOrientationToVertical();
