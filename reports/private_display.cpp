@@ -3,8 +3,8 @@
 #include <X11/Xlib.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/prctl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,8 +13,6 @@
 #include <cstring>
 #include <sstream>
 #include <vector>
-
-extern char** environ;
 
 namespace sailshape {
 
@@ -51,34 +49,56 @@ PrivateDisplay::PrivateDisplay(int timeout_ms) {
     throw DisplayError(std::string("[PrivateDisplay] ") +
                        (previous_.empty() ? "no DISPLAY is set" : "DISPLAY " + previous_ + " cannot be opened") +
                        " and Xvfb is not installed (apt install xvfb): the report's 3D views need an X display");
-  // Xvfb writes the display number it picked to this pipe once it accepts clients.
+  // Display numbers are taken explicitly: Xvfb then holds /tmp/.X<n>-lock and
+  // exits at once when another server has it. (-displayfd without a number
+  // lets two servers starting together both claim the same display.) The
+  // first number depends on the process id, so concurrent reports rarely collide.
+  const int first = 200 + static_cast<int>(getpid() % 500);
+  std::string last_error;
+  for (int attempt = 0; attempt < 40 && pid_ <= 0; ++attempt) {
+    const int n = first + attempt;
+    const std::string number = std::to_string(n);
+    std::string reported;
+    if (startXvfb(xvfb, number, timeout_ms, reported)) display_ = ":" + reported;
+    else last_error = "display :" + number + " taken or Xvfb failed";
+  }
+  if (pid_ <= 0)
+    throw DisplayError("[PrivateDisplay] " + xvfb + " did not start on any of 40 displays (" + last_error + ")");
+  setenv("DISPLAY", display_.c_str(), 1);
+}
+
+// Starts Xvfb on `number`; true with pid_ set once it reported the display
+// ready on the pipe, false (and the server reaped) when it exited or timed out.
+bool PrivateDisplay::startXvfb(const std::string& xvfb, const std::string& number, int timeout_ms,
+                               std::string& reported) {
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0)
     throw DisplayError(std::string("[PrivateDisplay] pipe: ") + std::strerror(errno));
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, fds[1], 3);  // dup2 clears close-on-exec
-  const int devnull = open("/dev/null", O_WRONLY | O_CLOEXEC);
-  if (devnull >= 0) {
-    posix_spawn_file_actions_adddup2(&actions, devnull, 1);
-    posix_spawn_file_actions_adddup2(&actions, devnull, 2);
-  }
-  std::vector<std::string> args = {xvfb, "-displayfd", "3", "-screen", "0", "1280x1024x24", "-nolisten", "tcp"};
+  std::vector<std::string> args = {xvfb, ":" + number, "-displayfd", "3", "-screen", "0", "1280x1024x24",
+                                   "-nolisten", "tcp"};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, xvfb.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
+  const int devnull = open("/dev/null", O_WRONLY | O_CLOEXEC);
+  const pid_t parent = getpid();
+  // fork + exec rather than posix_spawn: the server must die with this process
+  // (PR_SET_PDEATHSIG), also when VTK aborts it. Only async-signal-safe calls in the child.
+  const pid_t pid = fork();
+  if (pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);
+    dup2(fds[1], 3);  // dup2 clears close-on-exec
+    if (devnull >= 0) dup2(devnull, 1), dup2(devnull, 2);
+    execv(xvfb.c_str(), argv.data());
+    _exit(127);
+  }
   if (devnull >= 0) close(devnull);
   close(fds[1]);
-  if (rc != 0) {
+  if (pid < 0) {
     close(fds[0]);
-    throw DisplayError("[PrivateDisplay] cannot start " + xvfb + ": " + std::strerror(rc));
+    throw DisplayError("[PrivateDisplay] cannot start " + xvfb + ": " + std::strerror(errno));
   }
-  pid_ = pid;
 
-  std::string number;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
   bool done = false;
   while (!done) {
@@ -89,23 +109,22 @@ PrivateDisplay::PrivateDisplay(int timeout_ms) {
     if (poll(&p, 1, static_cast<int>(left)) <= 0) continue;
     char buf[32];
     const ssize_t n = read(fds[0], buf, sizeof(buf));
-    if (n <= 0) break;  // Xvfb exited without a display
+    if (n <= 0) break;  // Xvfb exited without a display (taken, or it failed)
     for (ssize_t i = 0; i < n; ++i) {
       if (buf[i] == '\n') done = true;
-      else number += buf[i];
+      else reported += buf[i];
     }
   }
   close(fds[0]);
-  if (!done || number.empty()) {
-    kill(pid_, SIGTERM);
-    waitpid(pid_, nullptr, 0);
-    pid_ = -1;
-    throw DisplayError("[PrivateDisplay] " + xvfb + " did not report a display within " + std::to_string(timeout_ms) +
-                       " ms");
+  if (!done || reported.empty()) {
+    kill(pid, SIGTERM);
+    waitpid(pid, nullptr, 0);
+    return false;
   }
-  display_ = ":" + number;
-  setenv("DISPLAY", display_.c_str(), 1);
+  pid_ = pid;
+  return true;
 }
+
 
 PrivateDisplay::~PrivateDisplay() {
   if (pid_ <= 0) return;

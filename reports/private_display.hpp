@@ -29,6 +29,8 @@ class PrivateDisplay {
   const std::string& display() const { return display_; }  // ":N"
 
  private:
+  bool startXvfb(const std::string& xvfb, const std::string& number, int timeout_ms, std::string& reported);
+
   pid_t pid_ = -1;
   std::string display_;
   std::string previous_;  // DISPLAY before, empty when unset
