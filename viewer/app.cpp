@@ -595,6 +595,11 @@ void App::drawView(float x, float y, float w, float h) {
         if (!io.MouseDown[0] && !io.MouseDown[1] && !io.MouseDown[2]) pick_.pressed_in_view = false;
       }
 
+      if (pick_.pending) {
+        pick_.info = viewport_->pick((*pick_.pending)[0] * avail.x, (*pick_.pending)[1] * avail.y);
+        pick_.pending.reset();
+      }
+
       ImDrawList* dl = ImGui::GetWindowDrawList();
       float ty = origin.y + 10;
       auto legend = [&](ImU32 col, const std::string& text) {

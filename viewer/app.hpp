@@ -4,6 +4,7 @@
 // structs below; drawing happens in App::frame() between ImGui::NewFrame and
 // ImGui::Render.
 #include <cstdint>
+#include <array>
 #include <deque>
 #include <map>
 #include <memory>
@@ -60,6 +61,7 @@ struct PickState {
   std::optional<PickInfo> info;
   float press_x = 0, press_y = 0;
   bool pressed_in_view = false;
+  std::optional<std::array<float, 2>> pending;  // scripted pick, fractions of the view
 };
 
 struct PlotState {
@@ -120,6 +122,10 @@ class App {
   bool settled() const;
   const MessageLog& log() const { return log_; }
   bool databaseOpen() const { return database_.db.has_value(); }
+  // Picks at (fx, fy), fractions of the 3D view (origin top-left), on the next drawn frame, as a click does.
+  void requestPick(float fx, float fy) { pick_.pending = std::array<float, 2>{fx, fy}; }
+  bool pickPending() const { return pick_.pending.has_value(); }
+  const std::optional<PickInfo>& lastPick() const { return pick_.info; }
   // Writes the PDF report of the selected scan (or its whole test) on the worker; false when
   // there is no scan to report on (the reason goes to the message log).
   bool startReport(const std::string& out_path, bool whole_test, const std::string& audience);

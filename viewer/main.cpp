@@ -30,6 +30,7 @@ struct Options {
   int width = 1600, height = 1000;
   bool exercise_window = false;
   bool deviation = false;
+  std::vector<float> pick;  // --pick FX,FY: fractions of the 3D view
   std::string report;  // --report: write this PDF once the first scan is loaded (scripted Report button)
 };
 
@@ -155,6 +156,7 @@ int run(const Options& o) {
   const bool shooting = !o.screenshot.empty();
   int counted = 0;
   bool report_started = o.report.empty();
+  bool pick_requested = o.pick.empty(), pick_printed = o.pick.empty();
   const auto started = std::chrono::steady_clock::now();
   bool timed_out = false;
   while (!glfwWindowShouldClose(window.handle)) {
@@ -183,6 +185,20 @@ int run(const Options& o) {
       // always show the same thing however fast the machine is.
       const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       if (!app.settled() && waited > 300) timed_out = true;
+      if (!pick_requested && app.settled()) {
+        app.requestPick(o.pick[0], o.pick[1]);
+        pick_requested = true;
+      } else if (pick_requested && !pick_printed && !app.pickPending()) {
+        pick_printed = true;
+        if (const auto& p = app.lastPick()) {
+          std::printf("picked %s at %.4f %.4f %.4f m", p->what.c_str(), p->point.x(), p->point.y(), p->point.z());
+          if (p->deviation_m) std::printf(", deviation %+.1f mm", 1000 * *p->deviation_m);
+          std::printf("\n");
+        } else {
+          std::printf("picked nothing\n");
+        }
+        std::fflush(stdout);
+      }
       if (!report_started && app.settled()) {
         report_started = true;
         if (!app.startReport(o.report, false, "designer")) return 1;
@@ -226,12 +242,18 @@ int main(int argc, char** argv) {
   cli.add_option("--report", o.report,
                  "with --screenshot: once the first scan is loaded, write its PDF trim report (designer) here, as the "
                  "Report button does, before counting frames");
+  cli.add_option("--pick", o.pick,
+                 "with --screenshot: once the first scan is loaded, pick as a click at FX,FY (fractions of the 3D "
+                 "view, from its top left) and print the point and its deviation")
+      ->expected(2)
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1.0));
   cli.add_flag("--deviation", o.deviation, "start with the flying shape coloured by signed deviation from the design");
   try {
     cli.parse(argc, argv);
     if (!o.screenshot.empty() && o.frames == 0) throw CLI::ValidationError("--screenshot", "needs --frames N");
-    if (o.screenshot.empty() && (o.frames || o.exercise_window || !o.report.empty()))
-      throw CLI::ValidationError("--frames", "--frames, --exercise-window and --report need --screenshot");
+    if (o.screenshot.empty() && (o.frames || o.exercise_window || !o.report.empty() || !o.pick.empty()))
+      throw CLI::ValidationError("--frames", "--frames, --exercise-window, --report and --pick need --screenshot");
     if (o.exercise_window && o.frames < 16) throw CLI::ValidationError("--exercise-window", "needs --frames >= 16");
   } catch (const CLI::ParseError& e) {
     return cli.exit(e);

@@ -4,6 +4,7 @@
 #include <stb_image.h>
 #include <sys/wait.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -119,7 +120,7 @@ TEST_F(ViewerApp, ShowsDesignAndFlyingDrawsThePanelsAndWritesTheReport) {
   const std::string png = dir_->file("shot.png");
   const std::string pdf = dir_->file("report.pdf");
   const ViewerRun r = runViewer(*dir_, quote(dir_->file("sails.sqlite")) + " --report " + quote(pdf) +
-                                           " --screenshot " + quote(png) + " --frames 4");
+                                           " --pick 0.55,0.55 --screenshot " + quote(png) + " --frames 4");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   const Image img = load(png);
@@ -137,6 +138,19 @@ TEST_F(ViewerApp, ShowsDesignAndFlyingDrawsThePanelsAndWritesTheReport) {
   EXPECT_GT(count(img, kAnalysis, kText), 1000u);
   // No scalar bar without deviation colours.
   EXPECT_LT(count(img, kScalarBar, kRed), 20u);
+  // A click in the middle of the view picks the flying surface: a point of the 10 m sail (tack at z = 1 m),
+  // to leeward of the design by what +2 % camber and +3° twist give (p5 > −3σ; the leech moves ≤ 0.25 m).
+  const auto at = r.out.find("picked flying surface at ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  double x = 0, y = 0, z = 0, deviation_mm = 0;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + at, "picked flying surface at %lf %lf %lf m, deviation %lf mm", &x, &y, &z,
+                        &deviation_mm),
+            4)
+      << r.out;
+  EXPECT_GT(z, 1.0);
+  EXPECT_LT(z, 11.0);
+  EXPECT_GT(deviation_mm, -3 * 1000 * test::kSensorSigmaM);
+  EXPECT_LT(deviation_mm, 250.0);
   // The Report button's PDF, written whole.
   const std::string bytes = slurp(pdf);
   ASSERT_GT(bytes.size(), 10'000u) << "no report at " << pdf;
@@ -196,6 +210,8 @@ TEST_F(ViewerApp, RefusesBadOptions) {
   EXPECT_NE(no_frames.exit_code, 0);
   EXPECT_NE(no_frames.err.find("--frames"), std::string::npos) << no_frames.err;
   EXPECT_FALSE(std::filesystem::exists(dir_->file("x.png")));
+  const ViewerRun bad_pick = runViewer(*dir_, "--pick 2,0.5 --screenshot " + quote(dir_->file("x.png")) + " --frames 2");
+  EXPECT_NE(bad_pick.exit_code, 0) << "a pick outside the view";
   const ViewerRun report_alone = runViewer(*dir_, "--report " + quote(dir_->file("x.pdf")));
   EXPECT_NE(report_alone.exit_code, 0);
   EXPECT_NE(report_alone.err.find("--screenshot"), std::string::npos) << report_alone.err;
