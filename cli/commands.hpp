@@ -12,5 +12,6 @@ void addCompareCommand(CLI::App& app);
 void addDbCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
+void addRegisterCommand(CLI::App& app);
 
 }  // namespace sailshape::cli

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   sailshape::cli::addDbCommand(app);
   sailshape::cli::addReplayCommand(app);
   sailshape::cli::addReportCommand(app);
+  sailshape::cli::addRegisterCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
