@@ -67,7 +67,7 @@ CrossedFilter crossedFilter(const Cloud& reference, const Cloud& moving, double 
   return result;
 }
 
-DistanceStats nearestDistanceStats(const Cloud& reference, const Cloud& moving, double bin_m, size_t bins) {
+NeighbourDistanceStats nearestDistanceStats(const Cloud& reference, const Cloud& moving, double bin_m, size_t bins) {
   if (reference.empty() || moving.empty())
     throw InvalidInput("[nearestDistanceStats] both clouds need points (reference " + std::to_string(reference.size()) +
                        ", moving " + std::to_string(moving.size()) + ")");
@@ -87,7 +87,7 @@ DistanceStats nearestDistanceStats(const Cloud& reference, const Cloud& moving, 
       d[static_cast<size_t>(i)] = std::sqrt(d2[0]);
     }
   }
-  DistanceStats s;
+  NeighbourDistanceStats s;
   s.count = d.size();
   s.bin_m = bin_m;
   s.histogram.assign(bins, 0);

@@ -23,14 +23,14 @@ struct CrossedFilter {
 CrossedFilter crossedFilter(const Cloud& reference, const Cloud& moving, double radius_m);
 
 // Distances from each moving point to its nearest reference point, m.
-struct DistanceStats {
+struct NeighbourDistanceStats {
   size_t count = 0;
   double mean_m = 0, median_m = 0, p90_m = 0, max_m = 0, rms_m = 0;
   double bin_m = 0.005;              // histogram bin width
   std::vector<size_t> histogram;     // counts in [i·bin, (i+1)·bin); the last bin also holds everything beyond
 };
 // Throws InvalidInput for an empty cloud or a bin width/count that is not positive.
-DistanceStats nearestDistanceStats(const Cloud& reference, const Cloud& moving, double bin_m = 0.005,
+NeighbourDistanceStats nearestDistanceStats(const Cloud& reference, const Cloud& moving, double bin_m = 0.005,
                                    size_t bins = 20);
 
 struct IcpParams {

@@ -82,7 +82,7 @@ struct Registration {
   // Overlap after the coarse alignment (crossed filter), and the distances from
   // those moving points to the reference before and after refinement.
   size_t overlap_reference_points = 0, overlap_moving_points = 0;
-  DistanceStats before_refinement, after_refinement;
+  NeighbourDistanceStats before_refinement, after_refinement;
 
   int icp_iterations = 0;
   bool converged = false;  // ICP converged (true when refinement is off)

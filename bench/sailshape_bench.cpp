@@ -26,10 +26,12 @@
 #include "analysis/design_compare.hpp"
 #include "analysis/normals.hpp"
 #include "analysis/pipeline.hpp"
+#include "analysis/registration.hpp"
 #include "analysis/sail_generator.hpp"
 #include "analysis/segmentation.hpp"
 #include "analysis/smoothing.hpp"
 #include "analysis/surface.hpp"
+#include "analysis/tunnel_scene.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"
 #include "database/schema.hpp"
@@ -281,6 +283,28 @@ void BM_Ours_SignedDistance(benchmark::State& state) {
 }
 
 
+// ---- registration (issue 5): the two-unit tunnel scene at about 200,000 points per unit ----
+// Plane method (detection in both clouds, matching, crossed filter, anchored
+// point-to-plane ICP) on 4 mm noise; counters give the errors against the truth.
+void BM_Ours_Registration(benchmark::State& state) {
+  TunnelSceneParams p;
+  p.noise_sigma_m = 0.004;
+  p.seed = 5;
+  const double scale = static_cast<double>(state.range(0)) / 23'800.0;  // the default scene has ~23,800 points per unit
+  p.chamber_density_per_m2 *= scale;
+  p.cube_density_per_m2 *= scale;
+  p.sail_points = static_cast<size_t>(static_cast<double>(p.sail_points) * scale);
+  const TunnelScene scene = makeTunnelScene(p);
+  Registration r;
+  for (auto _ : state) r = registerClouds(scene.reference, scene.moving);
+  state.counters["reference_points"] = static_cast<double>(scene.reference.size());
+  state.counters["moving_points"] = static_cast<double>(scene.moving.size());
+  state.counters["rotation_error_deg"] = rotationDifferenceDeg(r.rotation, scene.truth.linear());
+  state.counters["translation_error_mm"] = (r.translation - scene.truth.translation()).norm() * 1000;
+  state.counters["accepted"] = r.accepted ? 1 : 0;
+  finish(state, scene.reference.size() + scene.moving.size());
+}
+
 // ---- the design-flying database: 10,000 scans, 200,000 sections ----
 // 40 sails (10 boats, 4 types, 5 campaigns), 250 scans each in 25 tests of 10
 // trim steps; AWA uniform in 30..170°, forces and two control settings random
@@ -394,6 +418,7 @@ BENCHMARK(BM_Pcl_GreedyProjection)->SIZES;
 BENCHMARK(BM_Ours_WholeAnalysis)->SIZES;
 BENCHMARK(BM_Pcl_WholeAnalysis)->SIZES;
 BENCHMARK(BM_Ours_SignedDistance)->SIZES;
+BENCHMARK(BM_Ours_Registration)->Arg(50'000)->Arg(200'000)->Unit(benchmark::kMillisecond)->Iterations(1);
 #define QUERY Unit(benchmark::kMillisecond)
 BENCHMARK(BM_Db_ScansBySailAndAwa)->QUERY;
 BENCHMARK(BM_Db_ScansBySailTypeAndControl)->QUERY;

@@ -36,7 +36,7 @@ nlohmann::json matrixJson(const RigidTransform& t) {
   return m;
 }
 
-nlohmann::json statsJson(const DistanceStats& s) {
+nlohmann::json statsJson(const NeighbourDistanceStats& s) {
   return {{"count", s.count},   {"mean_m", s.mean_m}, {"median_m", s.median_m}, {"p90_m", s.p90_m},
           {"max_m", s.max_m},   {"rms_m", s.rms_m},   {"bin_m", s.bin_m},       {"histogram", s.histogram}};
 }

@@ -133,7 +133,7 @@ TEST(CrossedFilter, KeepsOnlyPointsWithANeighbourFromTheOtherCloud) {
   expectInvalidInput([&] { crossedFilter(a, b, 0); }, {"crossedFilter", "radius_m"});
 }
 
-TEST(DistanceStats, SummarisesNearestDistances) {
+TEST(NeighbourDistanceStats, SummarisesNearestDistances) {
   Cloud ref, mov;
   ref.points = {Vec3(0, 0, 0)};
   double sum2 = 0;
@@ -142,7 +142,7 @@ TEST(DistanceStats, SummarisesNearestDistances) {
     mov.points.push_back(Vec3(d, 0, 0));
     sum2 += d * d;
   }
-  const DistanceStats s = nearestDistanceStats(ref, mov, 0.005, 4);
+  const NeighbourDistanceStats s = nearestDistanceStats(ref, mov, 0.005, 4);
   EXPECT_EQ(s.count, 10u);
   EXPECT_NEAR(s.mean_m, 0.0115, 1e-12);
   EXPECT_NEAR(s.max_m, 0.0205, 1e-12);
