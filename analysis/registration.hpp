@@ -23,8 +23,11 @@ struct PlaneMatchParams {
   double min_triple_det = 0.25;         // |det| of the three unit normals whose intersection gives the translation
   size_t verify_samples = 2000;         // moving points that score each candidate match
   double verify_radius_m = 0.05;        // a sample counts when a reference point lies this close
-  // A second, different match scoring at least this fraction of the best makes the result ambiguous.
-  double ambiguity_ratio = 0.9;
+  // A second, different match that lands as many planes and brings at least
+  // this fraction of the best's sampled points near the reference makes the
+  // result ambiguous (never accepted). 0: any tie on planes — overlap alone is
+  // weak evidence, since a symmetric chamber turned end for end overlaps itself.
+  double ambiguity_ratio = 0.0;
 };
 
 struct RegistrationParams {

@@ -196,6 +196,20 @@ TEST(PlaneRegistration, UserHintsPickThePlanes) {
                                  {"registerClouds", "no plane of the reference cloud", "hint"});
 }
 
+TEST(PlaneRegistration, ASymmetricChamberIsAmbiguousNeverAccepted) {
+  // Without the cube's faces (too sparse to be planes) the two units share only
+  // floor, ceiling and screen, and the chamber turned end for end about its long
+  // axis lands as many planes as any other match: the result must say so and
+  // must not be accepted (the 200,000-point benchmark found this case).
+  TunnelSceneParams p;
+  p.noise_sigma_m = kSigma;
+  p.cube_density_per_m2 = 5;
+  const TunnelScene s = makeTunnelScene(p);
+  const Registration r = registerClouds(s.reference, s.moving);
+  EXPECT_TRUE(r.ambiguous);
+  EXPECT_FALSE(r.accepted);
+}
+
 TEST(PlaneRegistration, FewerThanThreePlanesIsAClearError) {
   // Floor and one wall only: the translation along the wall is free.
   const Cloud two = planesCloud({{Vec3(-2, -2, 0), Vec3(4, 0, 0), Vec3(0, 4, 0)},
