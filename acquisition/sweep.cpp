@@ -171,8 +171,10 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     double beta0 = 0, beta_rate = 0, beta_curve = 0;
     if (encoder) {
       if (s.encoders.empty()) {
-        sweep.warnings.push_back("scan " + std::to_string(s.scan_counter) +
-                                 " has no encoder block although beta_source is encoder: skipped");
+        // Scans streamed before the encoder block was switched on are expected; later ones are not.
+        if (used > 0)
+          sweep.warnings.push_back("scan " + std::to_string(s.scan_counter) +
+                                   " has no encoder block although beta_source is encoder: skipped");
         continue;
       }
       beta0 = encoderDeg(s);

@@ -120,6 +120,7 @@ SynchronisedSweeps runSynchronisedSweeps(const std::vector<UnitConfig>& units, c
   for (size_t i = 0; i < n; ++i) {
     threads.emplace_back([&, i] {
       SweepOptions o = options.sweep;
+      if (i < options.capture_paths.size()) o.capture_path = options.capture_paths[i];
       o.wait_for_start = [&, i] {
         {
           std::lock_guard<std::mutex> lock(m);

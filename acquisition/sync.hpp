@@ -49,6 +49,7 @@ struct SynchronisedSweeps {
 
 struct SyncOptions {
   SweepOptions sweep;               // wait_for_start is set by runSynchronisedSweeps
+  std::vector<std::string> capture_paths;  // per unit (empty, or one per unit): raw telegram captures
   double ready_timeout_s = 120;     // for every unit to be homed and streaming
   uint64_t trigger_id = 1;
 };

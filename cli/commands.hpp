@@ -13,5 +13,8 @@ void addDbCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addRegisterCommand(CLI::App& app);
+void addEmulateCommand(CLI::App& app);
+void addScanCommand(CLI::App& app);
+void addScannerCommand(CLI::App& app);
 
 }  // namespace sailshape::cli

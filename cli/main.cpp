@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
   sailshape::cli::addReplayCommand(app);
   sailshape::cli::addReportCommand(app);
   sailshape::cli::addRegisterCommand(app);
+  sailshape::cli::addEmulateCommand(app);
+  sailshape::cli::addScanCommand(app);
+  sailshape::cli::addScannerCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,152 @@
+// `sailshape scanner calibrate`: the unit's p and θ by least squares from sweeps of known shapes.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "acquisition/calibration.hpp"
+#include "acquisition/sweep_io.hpp"
+#include "acquisition/unit_config.hpp"
+#include "analysis/errors.hpp"
+#include "cli/commands.hpp"
+#include "cli/json_file.hpp"
+
+namespace sailshape::cli {
+namespace {
+
+constexpr double kDeg = M_PI / 180;
+
+struct CalibrateOptions {
+  std::vector<std::string> planes;
+  std::vector<std::string> cylinders;
+  std::vector<double> radii;
+  std::string unit;
+  double p0 = 0.05, theta0_deg = 0;
+  bool p0_set = false, theta0_set = false;
+  std::string json;
+  std::string write_unit;
+};
+
+// "FILE" or "FILE@xmin,xmax,ymin,ymax,zmin,zmax": samples kept inside the box (unit frame, metres, under the
+// initial p and θ).
+CalibrationTarget loadTarget(const std::string& spec, double p0, double theta0) {
+  CalibrationTarget t;
+  const auto at = spec.find('@');
+  const std::string file = spec.substr(0, at);
+  t.name = file;
+  std::vector<SweepPoint> samples = readSweepSamples(file);
+  if (at == std::string::npos) {
+    t.samples = std::move(samples);
+    return t;
+  }
+  std::vector<double> box;
+  std::stringstream ss(spec.substr(at + 1));
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      box.push_back(std::stod(item));
+    } catch (const std::exception&) {
+      box.clear();
+      break;
+    }
+  }
+  if (box.size() != 6 || box[0] >= box[1] || box[2] >= box[3] || box[4] >= box[5])
+    throw InvalidInput("[scanner calibrate] '" + spec + "': the crop box must be @xmin,xmax,ymin,ymax,zmin,zmax with min < max");
+  for (const SweepPoint& s : samples) {
+    const Vec3 x = unitPoint(s.range_m, s.alpha_rad, s.beta_rad, p0, theta0);
+    if (x.x() >= box[0] && x.x() <= box[1] && x.y() >= box[2] && x.y() <= box[3] && x.z() >= box[4] && x.z() <= box[5])
+      t.samples.push_back(s);
+  }
+  return t;
+}
+
+void run(const CalibrateOptions& o) {
+  if (o.planes.empty() && o.cylinders.empty())
+    throw InvalidInput("[scanner calibrate] give at least one --plane or --cylinder sample file");
+  if (o.radii.size() != o.cylinders.size())
+    throw InvalidInput("[scanner calibrate] every --cylinder needs its --radius (got " + std::to_string(o.cylinders.size()) +
+                       " cylinders and " + std::to_string(o.radii.size()) + " radii)");
+  UnitConfig unit;
+  CalibrationParams params;
+  if (!o.unit.empty()) {
+    unit = readUnitFile(o.unit);
+    if (unit.p_m > 0) params.initial_p_m = unit.p_m;
+    params.initial_theta_rad = unit.theta_rad;
+  }
+  if (o.p0_set) params.initial_p_m = o.p0;
+  if (o.theta0_set) params.initial_theta_rad = o.theta0_deg * kDeg;
+  std::vector<CalibrationTarget> targets;
+  for (const std::string& p : o.planes) targets.push_back(loadTarget(p, params.initial_p_m, params.initial_theta_rad));
+  for (size_t i = 0; i < o.cylinders.size(); ++i) {
+    CalibrationTarget t = loadTarget(o.cylinders[i], params.initial_p_m, params.initial_theta_rad);
+    t.kind = CalibrationTarget::Kind::Cylinder;
+    t.radius_m = o.radii[i];
+    targets.push_back(std::move(t));
+  }
+  const CalibrationResult r = calibrateUnit(targets, params);
+  std::printf("p = %.2f mm ± %.2f mm, theta = %.3f deg ± %.3f deg (%s after %d iterations)\n", r.p_m * 1000,
+              r.p_stderr_m * 1000, r.theta_rad / kDeg, r.theta_stderr_rad / kDeg,
+              r.converged ? "converged" : "NOT converged", r.iterations);
+  std::printf("%-40s %8s %8s %10s %10s\n", "target", "points", "dropped", "rms mm", "max mm");
+  for (const CalibrationTargetResult& t : r.targets)
+    std::printf("%-40s %8zu %8zu %10.2f %10.2f\n", t.name.c_str(), t.points, t.outliers, t.rms_m * 1000,
+                t.max_abs_m * 1000);
+  for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (!o.json.empty()) {
+    nlohmann::json doc{{"p_m", r.p_m},
+                       {"theta_deg", r.theta_rad / kDeg},
+                       {"p_stderr_m", r.p_stderr_m},
+                       {"theta_stderr_deg", r.theta_stderr_rad / kDeg},
+                       {"rms_m", r.rms_m},
+                       {"converged", r.converged},
+                       {"iterations", r.iterations},
+                       {"warnings", r.warnings},
+                       {"targets", nlohmann::json::array()}};
+    for (const CalibrationTargetResult& t : r.targets)
+      doc["targets"].push_back({{"name", t.name}, {"points", t.points}, {"dropped", t.outliers}, {"rms_m", t.rms_m},
+                                {"max_abs_m", t.max_abs_m}});
+    writeJsonFile(o.json, doc);
+  }
+  if (!o.write_unit.empty()) {
+    if (std::filesystem::exists(o.write_unit))
+      throw FileError("[scanner calibrate] " + o.write_unit + " exists already; not overwritten");
+    unit.p_m = r.p_m;
+    unit.theta_rad = r.theta_rad;
+    writeJsonFile(o.write_unit, nlohmann::json::parse(unitToJson(unit)));
+    std::fprintf(stderr, "wrote %s\n", o.write_unit.c_str());
+  }
+}
+
+}  // namespace
+
+void addScannerCommand(CLI::App& app) {
+  CLI::App* scanner = app.add_subcommand("scanner", "Scanner unit maintenance");
+  scanner->require_subcommand(1);
+  auto o = std::make_shared<CalibrateOptions>();
+  CLI::App* cmd = scanner->add_subcommand(
+      "calibrate",
+      "Estimate the unit's geometric constants p and θ (SPEC §2) by least squares from sweeps of known shapes: "
+      "planes of unknown position (a tunnel wall, the floor) and optionally cylinders of known radius. Two planes "
+      "at an angle, seen over a wide β range, determine θ best; standard errors and a warning show a weak set-up.");
+  cmd->add_option("--plane", o->planes,
+                  "Samples of a plane: NAME.samples.csv as `sailshape scan` writes it, optionally "
+                  "@xmin,xmax,ymin,ymax,zmin,zmax to keep only samples in that box (unit frame, metres, under the "
+                  "initial p and θ); repeat for several planes");
+  cmd->add_option("--cylinder", o->cylinders, "Samples of a cylinder (same form as --plane); repeat as needed");
+  cmd->add_option("--radius", o->radii, "Radius in metres of each --cylinder, in the same order");
+  cmd->add_option("--unit", o->unit, "Unit file: its p and θ are the starting guess and --write-unit starts from it")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--p0", o->p0, "Starting p in metres (> 0; default 0.05 or the unit's)")
+      ->check(CLI::PositiveNumber)
+      ->each([o](const std::string&) { o->p0_set = true; });
+  cmd->add_option("--theta0", o->theta0_deg, "Starting θ in degrees (default 0 or the unit's)")
+      ->each([o](const std::string&) { o->theta0_set = true; });
+  cmd->add_option("--json", o->json, "Write the result (p_m, theta_deg, standard errors, per-target residuals) as JSON");
+  cmd->add_option("--write-unit", o->write_unit,
+                  "Write the unit file (from --unit, or defaults) with the calibrated p and θ to this new path");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace sailshape::cli

@@ -1,0 +1,156 @@
+// `sailshape emulate`, `scan` and `scanner calibrate` run as a user would: an emulator process serving a
+// room, a scan through its TCP port and pty link, a calibration from the stored samples.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <thread>
+
+#include "tests/cli/run_sailshape.hpp"
+
+namespace fs = std::filesystem;
+using sailshape::testing::readText;
+using sailshape::testing::runSailshape;
+
+namespace {
+
+fs::path freshDir(const std::string& name) {
+  const fs::path d = fs::path(::testing::TempDir()) / ("acq_cli_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void writeText(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+// A wall y = 3 and a floor z = -1.5 around the unit (unit frame = scene frame), cloth.
+const char* kRoom = R"({"name": "room", "objects": [
+  {"type": "quad", "name": "wall", "material": "cloth", "corners": [[-20, 3, -20], [20, 3, -20], [20, 3, 20], [-20, 3, 20]]},
+  {"type": "quad", "name": "floor", "material": "cloth", "corners": [[-20, -20, -1.5], [20, -20, -1.5], [20, 20, -1.5], [-20, 20, -1.5]]}]})";
+
+// The emulator as a child process, stopped (by its pid) at the end of the test.
+class EmulatorProcess {
+ public:
+  EmulatorProcess(const fs::path& dir, const std::string& args) : out_(dir / "emulator.txt") {
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      const std::string cmd = std::string("exec '") + SAILSHAPE_BIN + "' emulate " + args + " >'" + out_.string() +
+                              "' 2>&1 </dev/null";
+      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+  }
+  ~EmulatorProcess() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGTERM);
+      int status = 0;
+      ::waitpid(pid_, &status, 0);
+    }
+  }
+  // The port it printed, or 0 after the timeout.
+  int port(double timeout_s = 20) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    const std::regex re("127\\.0\\.0\\.1:([0-9]+)");
+    while (std::chrono::steady_clock::now() < end) {
+      std::smatch m;
+      const std::string text = readText(out_);
+      if (std::regex_search(text, m, re)) return std::stoi(m[1]);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return 0;
+  }
+
+ private:
+  fs::path out_;
+  pid_t pid_ = -1;
+};
+
+}  // namespace
+
+TEST(AcquisitionCli, HelpExplainsTheOptions) {
+  const fs::path d = freshDir("help");
+  auto r = runSailshape(d, "emulate --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* opt : {"--model", "--scene", "--port", "--serial-link", "--unit", "--bind"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+  r = runSailshape(d, "scan --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* opt : {"--unit", "--out", "--trigger"}) EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+  r = runSailshape(d, "scanner calibrate --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* opt : {"--plane", "--cylinder", "--radius", "--write-unit"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+}
+
+TEST(AcquisitionCli, EmulateScanAndCalibrate) {
+  const fs::path d = freshDir("e2e");
+  writeText(d / "room.json", kRoom);
+  writeText(d / "truth.json", R"({"name": "truth", "p_m": 0.105, "theta_deg": 12})");
+  EmulatorProcess emu(d, "--model lms511 --port 0 --scene '" + (d / "room.json").string() + "' --unit '" +
+                             (d / "truth.json").string() + "' --serial-link '" + (d / "tt").string() +
+                             "' --duration 120");
+  const int port = emu.port();
+  ASSERT_GT(port, 0) << readText(d / "emulator.txt");
+  nlohmann::json unit{{"name", "room-unit"}, {"port", port}, {"serial_device", (d / "tt").string()},
+                      {"model", "lms511"},   {"p_m", 0.08},  {"theta_deg", 0},
+                      {"frequency_hz", 25},  {"resolution_deg", 0.1667},
+                      {"start_angle_deg", -160}, {"sweep_angle_deg", 230}, {"speed_deg_s", 90},
+                      {"acceleration_deg_s2", 900}};
+  writeText(d / "unit.json", unit.dump());
+  auto r = runSailshape(d, "scan --quiet --unit '" + (d / "unit.json").string() + "' --out '" + (d / "out").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* f : {"room-unit.ply", "room-unit.samples.csv", "room-unit.sscap", "scan.json"})
+    EXPECT_TRUE(fs::exists(d / "out" / f)) << f;
+  const auto doc = nlohmann::json::parse(readText(d / "out" / "scan.json"));
+  EXPECT_FALSE(doc["units"][0]["partial"].get<bool>());
+  EXPECT_GT(doc["units"][0]["points"].get<int>(), 20000);
+
+  // A second scan into the same directory is refused, and the stored scan stays as it was.
+  const auto size_before = fs::file_size(d / "out" / "room-unit.samples.csv");
+  r = runSailshape(d, "scan --quiet --unit '" + (d / "unit.json").string() + "' --out '" + (d / "out").string() + "'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("exists already"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(fs::file_size(d / "out" / "room-unit.samples.csv"), size_before);
+
+  // Calibrate from the wall and the floor, cropped under the starting guess (the unit file's p, θ).
+  const std::string samples = (d / "out" / "room-unit.samples.csv").string();
+  r = runSailshape(d, "scanner calibrate --unit '" + (d / "unit.json").string() + "' --plane '" + samples +
+                          "@-20,20,2.8,3.2,-1.2,20' --plane '" + samples + "@-20,20,-20,2.7,-1.7,-1.3' --json '" +
+                          (d / "cal.json").string() + "' --write-unit '" + (d / "calibrated.json").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto cal = nlohmann::json::parse(readText(d / "cal.json"));
+  EXPECT_NEAR(cal["p_m"].get<double>(), 0.105, 0.002);
+  // θ's standard error at this sweep density is ≈ 0.05°: allow four of them.
+  EXPECT_NEAR(cal["theta_deg"].get<double>(), 12.0, 0.2);
+  const auto written = nlohmann::json::parse(readText(d / "calibrated.json"));
+  EXPECT_NEAR(written["p_m"].get<double>(), cal["p_m"].get<double>(), 1e-9);
+  EXPECT_EQ(written["port"].get<int>(), port);
+}
+
+TEST(AcquisitionCli, ErrorsAreOneLine) {
+  const fs::path d = freshDir("errors");
+  writeText(d / "bad_scene.json", R"({"objects": [{"type": "torus"}]})");
+  writeText(d / "bad_unit.json", R"({"speed_deg_s": -1})");
+  writeText(d / "bad.csv", "range_m,alpha_rad,beta_rad,rssi,time_s\n1,2\n");
+  const std::vector<std::string> cases{
+      "emulate --scene '" + (d / "bad_scene.json").string() + "' --port 0 --duration 1",
+      "emulate --model lms999",
+      "scan --unit '" + (d / "bad_unit.json").string() + "' --out '" + (d / "o").string() + "'",
+      "scanner calibrate",
+      "scanner calibrate --plane '" + (d / "bad.csv").string() + "'",
+      "scanner calibrate --cylinder '" + (d / "bad.csv").string() + "'",
+  };
+  for (const std::string& c : cases) {
+    const auto r = runSailshape(d, c);
+    EXPECT_NE(r.exit_code, 0) << c;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c << ": " << r.err;
+  }
+}
