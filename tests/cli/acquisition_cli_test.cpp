@@ -128,8 +128,9 @@ TEST(AcquisitionCli, EmulateScanAndCalibrate) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto cal = nlohmann::json::parse(readText(d / "cal.json"));
   EXPECT_NEAR(cal["p_m"].get<double>(), 0.105, 0.002);
-  // θ's standard error at this sweep density is ≈ 0.05°: allow four of them.
-  EXPECT_NEAR(cal["theta_deg"].get<double>(), 12.0, 0.2);
+  // This fast, sparse sweep (90 °/s, 3.6° of β between scans) checks the command's plumbing; θ to 0.1° needs
+  // the slower, denser sweep of tests/acquisition/calibration_test.cpp.
+  EXPECT_NEAR(cal["theta_deg"].get<double>(), 12.0, 0.5);
   const auto written = nlohmann::json::parse(readText(d / "calibrated.json"));
   EXPECT_NEAR(written["p_m"].get<double>(), cal["p_m"].get<double>(), 1e-9);
   EXPECT_EQ(written["port"].get<int>(), port);
