@@ -38,18 +38,6 @@ Mesh makeHull(double stern_x, double bow_x, double half_beam, double deck_z, dou
   return m;
 }
 
-SailDesign scaledDesign(SailDesign d, double s) {
-  d.luff_m *= s;
-  d.leech_m *= s;
-  d.foot_m *= s;
-  d.head_width_m *= s;
-  d.tack *= s;
-  d.luff_round_m *= s;
-  d.luff_sag_m *= s;
-  d.leech_round_m *= s;
-  return d;
-}
-
 SceneObject sailObject(const std::string& name, const SailDesign& design, int rows = 80, int columns = 40) {
   return {name, Material::Cloth, generateSailMesh(design, rows, columns)};
 }
@@ -87,7 +75,7 @@ SailDesign sailFromJson(const json& j, const std::string& at) {
   if (!j.contains("sail_type") || !j.at("sail_type").is_string())
     throw InvalidInput(at + ": missing 'sail_type' (main, square-top, jib, gennaker)");
   SailDesign d = exampleDesign(parseSailType(j.at("sail_type").get<std::string>()));
-  d = scaledDesign(d, numberOr(j, "scale", 1.0, at));
+  d = scaleDesign(d, numberOr(j, "scale", 1.0, at));
   d.luff_m = numberOr(j, "luff_m", d.luff_m, at);
   d.leech_m = numberOr(j, "leech_m", d.leech_m, at);
   d.foot_m = numberOr(j, "foot_m", d.foot_m, at);
@@ -229,9 +217,9 @@ Scene builtInTunnelScene() {
   s.objects.push_back({"mast", Material::Metal, makeCylinder(Vec3(0.035, 0, 0), Vec3::UnitZ(), 0.025, 3.05, 16)});
   s.objects.push_back({"boom", Material::Metal,
                        makeCylinder(Vec3(0.0, 0, 0.26), -Vec3::UnitX(), 0.015, 1.05, 12)});
-  SailDesign main = scaledDesign(exampleDesign(SailType::Main), kScale);
+  SailDesign main = scaleDesign(exampleDesign(SailType::Main), kScale);
   s.objects.push_back(sailObject("main", main));
-  SailDesign gennaker = scaledDesign(exampleDesign(SailType::Gennaker), kScale);
+  SailDesign gennaker = scaleDesign(exampleDesign(SailType::Gennaker), kScale);
   gennaker.stations = {{0.0, 20, 45, 32, 2.4, 1.8}, {0.5, 25, 48, 42, 2.4, 1.8}, {1.0, 17, 50, 56, 2, 2}};  // A2 running
   s.objects.push_back(sailObject("gennaker", gennaker));
   return s;

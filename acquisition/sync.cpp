@@ -18,6 +18,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "analysis/errors.hpp"
+
 #include "acquisition/turntable.hpp"
 
 namespace sailshape {
@@ -102,6 +104,9 @@ void sendTrigger(const std::vector<TriggerEndpoint>& to, uint64_t id) {
 SynchronisedSweeps runSynchronisedSweeps(const std::vector<UnitConfig>& units, const SyncOptions& options,
                                          const Progress& progress) {
   const size_t n = units.size();
+  if (!options.capture_paths.empty() && options.capture_paths.size() != n)
+    throw InvalidInput("[runSynchronisedSweeps] capture_paths must name one capture per unit (" + std::to_string(n) +
+                       " units, got " + std::to_string(options.capture_paths.size()) + ")");
   SynchronisedSweeps out;
   out.sweeps.resize(n);
   out.errors.resize(n);

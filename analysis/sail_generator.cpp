@@ -146,6 +146,19 @@ SailDesign exampleDesign(SailType type) {
   return d;
 }
 
+SailDesign scaleDesign(SailDesign d, double s) {
+  if (!(s > 0) || !std::isfinite(s)) throw InvalidInput("[scaleDesign] scale must be > 0 (got " + std::to_string(s) + ")");
+  d.luff_m *= s;
+  d.leech_m *= s;
+  d.foot_m *= s;
+  d.head_width_m *= s;
+  d.tack *= s;
+  d.luff_round_m *= s;
+  d.luff_sag_m *= s;
+  d.leech_round_m *= s;
+  return d;
+}
+
 void validateDesign(const SailDesign& d) {
   auto positive = [](double v, const char* name) {
     if (!(v > 0) || !std::isfinite(v))

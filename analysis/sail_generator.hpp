@@ -53,6 +53,10 @@ SailDesign exampleDesign(SailType type);
 // Throws InvalidInput naming the offending field.
 void validateDesign(const SailDesign& design);
 
+// The design at `scale` (a wind-tunnel model of it): every length and the tack
+// position scaled, shape stations (percentages and angles) unchanged.
+SailDesign scaleDesign(SailDesign design, double scale);
+
 // The parameters a section of the design has, by construction.
 struct KnownSection {
   double fraction = 0;

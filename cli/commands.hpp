@@ -10,6 +10,7 @@ void addSimulateCommand(CLI::App& app);
 void addDesignCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addDbCommand(CLI::App& app);
+void addDemoCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addRegisterCommand(CLI::App& app);

@@ -1,0 +1,167 @@
+// `sailshape demo` reduced (two trim steps, fewer scan lines) run as a user
+// would, then the database and the reports it leaves are checked: every sweep
+// stored with its registration, the transform reused from step to step, the
+// sections of each analysed sail, the design comparison, the simulated forces
+// labelled as such, and a readable PDF per sail.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tests/cli/run_sailshape.hpp"
+#include "database/schema.hpp"
+#include "database/sqlite.hpp"
+
+namespace fs = std::filesystem;
+using sailshape::testing::Outcome;
+using sailshape::testing::runSailshape;
+
+namespace {
+
+std::string runCommand(const std::string& cmd) {
+  std::string out;
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  if (!pipe) return out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof(buf), pipe.get())) > 0) out.append(buf, n);
+  return out;
+}
+
+class DemoRun : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("sailshape-demo-test-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    outcome_ = runSailshape(dir_, "demo --dir '" + (dir_ / "out").string() + "' --steps 2 --scan-lines 300 --quiet");
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static fs::path dir_;
+  static Outcome outcome_;
+};
+fs::path DemoRun::dir_;
+Outcome DemoRun::outcome_;
+
+TEST_F(DemoRun, FinishesAndSaysWhereEverythingIs) {
+  ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
+  EXPECT_NE(outcome_.out.find("sailshape.db"), std::string::npos);
+  EXPECT_NE(outcome_.out.find("sailshape-viewer"), std::string::npos);
+  EXPECT_NE(outcome_.out.find("simulated"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "tunnel-main-lms511.json"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "tunnel-gennaker-lms111.json"));
+}
+
+TEST_F(DemoRun, StoresEverySweepWithItsRegistrationAndCapture) {
+  ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
+  sailshape::Database db = sailshape::openSailDatabase((dir_ / "out" / "sailshape.db").string());
+  auto st = db.prepare(
+      "SELECT s.id, s.point_count, s.raw_capture, t.step_order, sa.name, r.transform, r.fitness, t.drive_n, s.settings "
+      "FROM scans s JOIN trim_steps t ON t.id = s.trim_step_id JOIN sails sa ON sa.id = t.sail_id "
+      "JOIN registrations r ON r.scan_id = s.id ORDER BY sa.name, t.step_order");
+  std::map<std::string, std::vector<nlohmann::json>> transforms;
+  int rows = 0;
+  while (st.step()) {
+    ++rows;
+    EXPECT_GT(st.columnInt(1), 50000) << "a sweep of the tunnel returns most beams";
+    EXPECT_TRUE(fs::exists(st.columnText(2))) << st.columnText(2);
+    transforms[st.columnText(4)].push_back(nlohmann::json::parse(st.columnText(5)));
+    // The wall registration's fitness stays under the sensor uncertainty at model scale (SPEC §4: 9 mm).
+    EXPECT_LT(st.columnDouble(6), 0.009);
+    EXPECT_TRUE(std::isfinite(st.columnDouble(7)));
+    const auto settings = nlohmann::json::parse(st.columnText(8));
+    EXPECT_NE(settings.value("forces", std::string()).find("simulated"), std::string::npos);
+  }
+  EXPECT_EQ(rows, 4) << "two units, two trim steps";
+  ASSERT_EQ(transforms.size(), 2u);
+  for (const auto& [sail, list] : transforms) {
+    ASSERT_EQ(list.size(), 2u) << sail;
+    EXPECT_EQ(list[0], list[1]) << sail << ": the units did not move, so the first transform is reused";
+  }
+}
+
+TEST_F(DemoRun, EachTrimStepEasesTheTackAndKeepsItsConditions) {
+  ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
+  sailshape::Database db = sailshape::openSailDatabase((dir_ / "out" / "sailshape.db").string());
+  auto st = db.prepare(
+      "SELECT t.step_order, t.awa_deg, c.value FROM trim_steps t JOIN control_settings c ON c.trim_step_id = t.id "
+      "WHERE c.name = 'gennaker_tack_ease_m' AND t.test = 'A2 tack ease' ORDER BY t.step_order");
+  int rows = 0;
+  while (st.step()) {
+    ++rows;
+    const int step = st.columnInt(0);
+    EXPECT_DOUBLE_EQ(st.columnDouble(1), 110.0);
+    EXPECT_NEAR(st.columnDouble(2), 0.02 * (step - 1), 1e-12);
+  }
+  EXPECT_EQ(rows, 4);
+}
+
+TEST_F(DemoRun, AnalysedSailsHaveSectionsAndADesignComparison) {
+  ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
+  sailshape::Database db = sailshape::openSailDatabase((dir_ / "out" / "sailshape.db").string());
+  auto st = db.prepare(
+      "SELECT sa.name, COUNT(se.id), MIN(se.camber_pct), MAX(se.camber_pct), MIN(dc.rms_m), MAX(dc.rms_m) "
+      "FROM analyses a JOIN scans s ON s.id = a.scan_id JOIN trim_steps t ON t.id = s.trim_step_id "
+      "JOIN sails sa ON sa.id = t.sail_id JOIN sections se ON se.analysis_id = a.id "
+      "JOIN design_comparisons dc ON dc.analysis_id = a.id GROUP BY sa.name");
+  std::map<std::string, int> sections;
+  while (st.step()) {
+    const std::string sail = st.columnText(0);
+    sections[sail] = st.columnInt(1);
+    // Designed camber: main 9–11 %, A2 17–25 %; the flying shapes stay within a few % of it.
+    const double lo = sail.find("main") != std::string::npos ? 5.0 : 12.0;
+    const double hi = sail.find("main") != std::string::npos ? 14.0 : 30.0;
+    EXPECT_GT(st.columnDouble(2), lo) << sail;
+    EXPECT_LT(st.columnDouble(3), hi) << sail;
+    // The flying shapes are trimmed away from the design: centimetres, not metres, apart.
+    EXPECT_GT(st.columnDouble(4), 0.002) << sail;
+    EXPECT_LT(st.columnDouble(5), 0.15) << sail;
+  }
+  // The main is analysed at every step; three sections each (the default).
+  EXPECT_EQ(sections["Demo 36 main"], 6) << outcome_.out;
+  EXPECT_GE(sections["Demo 36 A2"], 3) << "the gennaker is analysed at one step at least:\n" << outcome_.out;
+}
+
+TEST_F(DemoRun, WritesAReadableReportPerSail) {
+  ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
+  for (const char* name : {"report-main.pdf", "report-a2.pdf"}) {
+    const fs::path pdf = dir_ / "out" / name;
+    ASSERT_TRUE(fs::exists(pdf)) << pdf << "\n" << outcome_.out;
+    const std::string info = runCommand("pdfinfo '" + pdf.string() + "' 2>/dev/null");
+    EXPECT_NE(info.find("Pages:"), std::string::npos) << info;
+    const std::string text = runCommand("pdftotext '" + pdf.string() + "' - 2>/dev/null");
+    EXPECT_NE(text.find("A2 tack ease"), std::string::npos);
+  }
+}
+
+TEST(DemoCommand, RefusesToOverwriteAnEarlierRun) {
+  const fs::path dir = fs::temp_directory_path() / ("sailshape-demo-again-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "out");
+  { std::ofstream(dir / "out" / "sailshape.db") << "earlier results"; }
+  const Outcome o = runSailshape(dir, "demo --dir '" + (dir / "out").string() + "' --quiet");
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.err.find("already exists"), std::string::npos) << o.err;
+  EXPECT_EQ(sailshape::testing::readText(dir / "out" / "sailshape.db"), "earlier results");
+  fs::remove_all(dir);
+}
+
+TEST(DemoCommand, RejectsBadOptions) {
+  const fs::path dir = fs::temp_directory_path() / ("sailshape-demo-bad-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  EXPECT_EQ(runSailshape(dir, "demo --steps 0 --dir '" + (dir / "x").string() + "'").exit_code, 2);
+  EXPECT_EQ(runSailshape(dir, "demo --scan-lines 5 --dir '" + (dir / "x").string() + "'").exit_code, 2);
+  EXPECT_FALSE(fs::exists(dir / "x" / "sailshape.db"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
