@@ -1,5 +1,6 @@
 // `sailshape register` run as a user would, on the synthetic two-unit tunnel scene.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -26,7 +27,8 @@ constexpr double kSigma = 0.004;  // SPEC §3
 class RegisterCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = fs::temp_directory_path() / "sailshape_register_cli";
+    // ctest runs each case in its own process, two at a time: each process gets its own folder.
+    dir_ = fs::temp_directory_path() / ("sailshape_register_cli_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     sailshape::TunnelSceneParams p;
