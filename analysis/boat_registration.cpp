@@ -26,19 +26,12 @@ double angleDeg(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.do
 double lineAngleDeg(const Vec3& a, const Vec3& b) { return std::acos(std::min(1.0, std::abs(a.dot(b)))) / kDeg; }
 double det3(const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); }
 
-Vec3 faceIntersection(const ReferenceFace& a, const ReferenceFace& b, const ReferenceFace& c) {
-  Eigen::Matrix3d m;
-  m.row(0) = a.normal.transpose();
-  m.row(1) = b.normal.transpose();
-  m.row(2) = c.normal.transpose();
-  return m.partialPivLu().solve(Vec3(a.offset_m, b.offset_m, c.offset_m));
-}
-
-Eigen::Matrix3d rotationFromNormals(const Vec3& ref1, const Vec3& ref2, const Vec3& mov1, const Vec3& mov2) {
-  const Eigen::Matrix3d r1 = rotationAligning(mov1, ref1);
-  const Vec3 v = r1 * mov2;
-  const Vec3 a = v - v.dot(ref1) * ref1, b = ref2 - ref2.dot(ref1) * ref1;
-  return Eigen::AngleAxisd(std::atan2(a.cross(b).dot(ref1), a.dot(b)), ref1).toRotationMatrix() * r1;
+// A reference face as a plane for intersectPlanes (only normal and offset are used).
+DetectedPlane asPlane(const ReferenceFace& f) {
+  DetectedPlane p;
+  p.normal = f.normal;
+  p.offset_m = f.offset_m;
+  return p;
 }
 
 Vec3 jsonVec(const nlohmann::json& j, const std::string& source, const std::string& field) {
@@ -184,13 +177,15 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
           if ((det3(F[fs[0]].normal, F[fs[1]].normal, F[fs[2]].normal) > 0) !=
               (det3(D[a].normal, D[b].normal, D[c].normal) > 0))
             continue;
-          const Eigen::Matrix3d rot = rotationFromNormals(F[fs[0]].normal, F[fs[1]].normal, D[a].normal, D[b].normal);
+          const Eigen::Matrix3d rot =
+              rotationFromNormalPairs(F[fs[0]].normal, F[fs[1]].normal, D[a].normal, D[b].normal);
           if (angleDeg(rot * D[c].normal, F[fs[2]].normal) > tol) continue;
           any_consistent = true;
           if (rotationDifferenceDeg(rot, p.prior_rotation) > p.prior_tolerance_deg) continue;
           RigidTransform t = RigidTransform::Identity();
           t.linear() = rot;
-          t.translation() = faceIntersection(F[fs[0]], F[fs[1]], F[fs[2]]) - rot * intersectPlanes(D[a], D[b], D[c]);
+          t.translation() = intersectPlanes(asPlane(F[fs[0]]), asPlane(F[fs[1]]), asPlane(F[fs[2]]), 0.0) -
+                            rot * intersectPlanes(D[a], D[b], D[c]);
           bool seen = false;
           for (const Candidate& o : candidates)
             seen = seen || (rotationDifferenceDeg(o.t.linear(), rot) < 1.0 && (o.t.translation() - t.translation()).norm() < 0.05);

@@ -55,25 +55,6 @@ std::vector<uint32_t> allIndices(size_t n) {
   return v;
 }
 
-// Where three planes meet (their normals are known to be independent here).
-Vec3 meetingPoint(const DetectedPlane& a, const DetectedPlane& b, const DetectedPlane& c) {
-  Eigen::Matrix3d m;
-  m.row(0) = a.normal.transpose();
-  m.row(1) = b.normal.transpose();
-  m.row(2) = c.normal.transpose();
-  return m.partialPivLu().solve(Vec3(a.offset_m, b.offset_m, c.offset_m));
-}
-
-// Rotation from two normal pairs as the study builds it: align the first pair,
-// then turn about the first reference normal until the second pair agrees.
-Eigen::Matrix3d rotationFromNormals(const Vec3& ref1, const Vec3& ref2, const Vec3& mov1, const Vec3& mov2) {
-  const Eigen::Matrix3d r1 = rotationAligning(mov1, ref1);
-  const Vec3 v = r1 * mov2;
-  const Vec3 a = v - v.dot(ref1) * ref1, b = ref2 - ref2.dot(ref1) * ref1;
-  const double angle = std::atan2(a.cross(b).dot(ref1), a.dot(b));
-  return Eigen::AngleAxisd(angle, ref1).toRotationMatrix() * r1;
-}
-
 void checkParams(const Cloud& reference, const Cloud& moving, const RegistrationParams& p) {
   auto bad = [](const std::string& what) { throw InvalidInput("[registerClouds] " + what); };
   if (p.method != "planes" && p.method != "svd" && p.method != "icp")
@@ -277,14 +258,16 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
         continue;
       any_moving_set = true;
       Candidate c;
-      const Eigen::Matrix3d rot = rotationFromNormals(R[rs[0]].normal, R[rs[1]].normal, M[ms[0]].normal, M[ms[1]].normal);
+      const Eigen::Matrix3d rot =
+          rotationFromNormalPairs(R[rs[0]].normal, R[rs[1]].normal, M[ms[0]].normal, M[ms[1]].normal);
       if (need == 3 && angleDeg(rot * M[ms[2]].normal, R[rs[2]].normal) > tol) continue;
       c.transform = RigidTransform::Identity();
       c.transform.linear() = rot;
       if (pair_translation) {
         c.transform.translation() = p.pairs[0].reference - rot * p.pairs[0].moving;
       } else {
-        c.transform.translation() = meetingPoint(R[rs[0]], R[rs[1]], R[rs[2]]) - rot * meetingPoint(M[ms[0]], M[ms[1]], M[ms[2]]);
+        c.transform.translation() = intersectPlanes(R[rs[0]], R[rs[1]], R[rs[2]], 0.0) -
+                                    rot * intersectPlanes(M[ms[0]], M[ms[1]], M[ms[2]], 0.0);
       }
       for (size_t x = 0; x < 3; ++x) {
         c.ref[x] = x < rs.size() ? rs[x] : rs[0];
@@ -388,7 +371,7 @@ SurfaceFit surfaceFit(const Cloud& reference, const Cloud& aligned, double radiu
 
 RigidTransform transformFromPlanes(const DetectedPlane (&reference)[3], const DetectedPlane (&moving)[3]) {
   const Eigen::Matrix3d rot =
-      rotationFromNormals(reference[0].normal, reference[1].normal, moving[0].normal, moving[1].normal);
+      rotationFromNormalPairs(reference[0].normal, reference[1].normal, moving[0].normal, moving[1].normal);
   const Vec3 xr = intersectPlanes(reference[0], reference[1], reference[2]);
   const Vec3 xm = intersectPlanes(moving[0], moving[1], moving[2]);
   RigidTransform t = RigidTransform::Identity();

@@ -120,6 +120,14 @@ Eigen::Matrix3d rotationAligning(const Vec3& from, const Vec3& to) {
   return Eigen::Matrix3d::Identity() + vx + vx * vx * ((1 - c) / s2);
 }
 
+Eigen::Matrix3d rotationFromNormalPairs(const Vec3& ref1, const Vec3& ref2, const Vec3& mov1, const Vec3& mov2) {
+  const Eigen::Matrix3d r1 = rotationAligning(mov1, ref1);
+  const Vec3 v = r1 * mov2;
+  const Vec3 a = v - v.dot(ref1) * ref1, b = ref2 - ref2.dot(ref1) * ref1;
+  const double angle = std::atan2(a.cross(b).dot(ref1), a.dot(b));
+  return Eigen::AngleAxisd(angle, ref1).toRotationMatrix() * r1;
+}
+
 double rotationDifferenceDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   const double c = std::clamp(((a.transpose() * b).trace() - 1) / 2, -1.0, 1.0);
   // acos loses precision near 0; the sine from the skew part keeps small angles exact.

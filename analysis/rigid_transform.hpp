@@ -38,6 +38,10 @@ KabschFit fitKabsch(const std::vector<PointPair>& pairs);
 // to `from`. Throws InvalidInput for a zero or non-finite vector.
 Eigen::Matrix3d rotationAligning(const Vec3& from, const Vec3& to);
 
+// Rotation from two pairs of unit normals as the study builds it (§5.3): align
+// mov1 onto ref1, then turn about ref1 until mov2 lies in the plane of ref1 and ref2.
+Eigen::Matrix3d rotationFromNormalPairs(const Vec3& ref1, const Vec3& ref2, const Vec3& mov1, const Vec3& mov2);
+
 // Angle of the rotation R_a⁻¹·R_b, degrees: how far two rotations differ.
 double rotationDifferenceDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
 
