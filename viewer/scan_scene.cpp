@@ -25,11 +25,12 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
     scene.raw_cloud = thinCloud(*record.cloud, options.max_cloud_points);
     if (options.analyze_cloud) {
       try {
-        scene.analysis = analyzeSail(*record.cloud, options.analysis, progress);
+        scene.analysis = analyzeSail(cropToBox(*record.cloud, options.roi), options.analysis, progress);
         scene.surface = scene.analysis->mesh;
       } catch (const Cancelled&) {
         throw;
       } catch (const std::exception& e) {
+        scene.analysis_error = e.what();
         scene.warnings.push_back(std::string("flying surface: the pipeline failed on the stored cloud: ") + e.what());
       }
     }
@@ -52,6 +53,8 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
       scene.surface_deviation_m = signedDistances(distance, scene.surface.vertices, progress);
       scene.deviation = distanceStats(scene.surface_deviation_m);
     }
+    if (scene.analysis && !scene.analysis->sail_cloud.empty())
+      scene.cluster_deviation_m = signedDistances(distance, scene.analysis->sail_cloud.points, progress);
     if (!scene.raw_cloud.empty()) {
       scene.raw_deviation_m = signedDistances(distance, scene.raw_cloud.points, progress);
       if (!scene.deviation) scene.deviation = distanceStats(scene.raw_deviation_m);

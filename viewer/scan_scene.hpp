@@ -10,12 +10,14 @@
 #include "analysis/design_compare.hpp"
 #include "analysis/pipeline.hpp"
 #include "database/scan_record.hpp"
+#include "viewer/processing.hpp"
 
 namespace sailshape::viewer {
 
 struct SceneOptions {
   bool analyze_cloud = true;      // run the pipeline on the stored cloud for the flying surface
   AnalysisParams analysis;        // the pipeline's parameters for that run
+  RoiBox roi;                     // the pipeline runs on the points inside (when enabled); the display keeps all
   bool design_sections = true;    // cut the design at the flying fractions (needed for the section table)
   size_t max_cloud_points = 300'000;  // the raw cloud is thinned (every k-th point) above this for display
 };
@@ -25,6 +27,8 @@ struct ScanScene {
   Cloud raw_cloud;                // as stored (thinned for display), boat frame, metres
   std::vector<double> raw_deviation_m;      // per raw_cloud point; empty without a design
   std::optional<SailAnalysis> analysis;     // the pipeline's run on the stored cloud
+  std::string analysis_error;     // why that run failed (empty when it worked or did not run)
+  std::vector<double> cluster_deviation_m;  // per analysis->sail_cloud point; empty without a design
   Mesh surface;                   // flying surface (the analysis mesh); empty when unavailable
   std::vector<double> surface_deviation_m;  // per surface vertex; empty without a design
   // The stored sections, or the fresh analysis's when the scan has none stored.

@@ -76,8 +76,9 @@ UnitConfig deckUnit(const Vec3& position_m) {
   u.model = ScannerModel::Lms511;
   // Unit X (the shaft) to boat +Z; β = 0 then looks to port (+Y).
   u.pose = makePose(position_m, 0.0, -M_PI / 2, 0.0);
-  u.start_angle_deg = -60;
-  u.sweep_angle_deg = 120;
+  // β turns the fan from port towards aft: the mainsail (mast to clew) lies at β ≈ 10°..50°.
+  u.start_angle_deg = 0;
+  u.sweep_angle_deg = 55;
   u.speed_deg_s = 30;
   u.acceleration_deg_s2 = 120;
   u.frequency_hz = 50;
@@ -118,6 +119,19 @@ void ScannerSession::home(size_t index, double timeout_s) const {
   link.baud = units_[index].config.baud;
   TurntableClient client(link);
   client.home(timeout_s);
+}
+
+void ScannerSession::stopTurntables(double timeout_s) const {
+  for (const ScannerUnitSlot& u : units_) {
+    TurntableLinkParams link;
+    link.device = u.config.serial_device;
+    link.baud = u.config.baud;
+    TurntableClient client(link);
+    client.stop();
+    if (!client.waitIdle(timeout_s))
+      throw TurntableError("[ScannerSession::stopTurntables] " + u.config.name + ": the turntable still moves after " +
+                           std::to_string(timeout_s) + " s");
+  }
 }
 
 Acquisition ScannerSession::scan(const SweepOptions& options, const Progress& progress) const {

@@ -63,7 +63,7 @@ struct Acquisition {
 };
 
 // A unit for the emulated deck scene (scene/boat frame: +X forward, +Y port, +Z up):
-// shaft vertical at `position_m`, looking to port, sweeping ±60° in azimuth.
+// shaft vertical at `position_m`, looking to port at β = 0 and sweeping 55° aft over the mainsail.
 UnitConfig deckUnit(const Vec3& position_m = Vec3(1.5, -6.0, 1.2));
 
 class ScannerSession {
@@ -78,6 +78,9 @@ class ScannerSession {
 
   // Homes unit `index`'s turntable. Throws InvalidInput for a bad index, TurntableError when homing fails.
   void home(size_t index, double timeout_s = 60) const;
+  // Stops every unit's turntable and waits until it stands (after a cancelled scan: the drive
+  // refuses to home while it still moves). Throws TurntableError naming the unit that fails.
+  void stopTurntables(double timeout_s = 10) const;
   // One scan of every unit, synchronised by the UDP trigger when there are several.
   // Throws InvalidInput without units, and what runSweep throws for a single unit.
   Acquisition scan(const SweepOptions& options = {}, const Progress& progress = {}) const;
