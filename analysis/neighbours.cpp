@@ -1,9 +1,12 @@
 #include "analysis/neighbours.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
+#include <mutex>
 #include <nanoflann.hpp>
 #include <string>
+#include <utility>
 
 #include "analysis/errors.hpp"
 
@@ -59,45 +62,377 @@ void KdTree::withinRadius(const Vec3& q, double radius_m, std::vector<uint32_t>&
   }
 }
 
+namespace {
+
+// (squared distance, index): ordered by distance, ties by index.
+using Candidate = std::pair<double, uint32_t>;
+
+// Sorts the k nearest of `cand` to its front (cand.size() >= k).
+void keepNearest(std::vector<Candidate>& cand, size_t k) {
+  if (cand.size() > k) std::nth_element(cand.begin(), cand.begin() + static_cast<long>(k - 1), cand.end());
+  std::sort(cand.begin(), cand.begin() + static_cast<long>(k));
+}
+
+// Writes the first k candidates as point i's row, the point itself first: duplicate
+// points (distance 0, lower index) can push it out of the k or off slot 0.
+void writeRow(const std::vector<Candidate>& cand, size_t k, uint32_t i, uint32_t* row, float* row_d2) {
+  size_t self = k;
+  for (size_t j = 0; j < k; ++j)
+    if (cand[j].second == i) self = j;
+  row[0] = i;
+  row_d2[0] = 0.0f;
+  size_t out = 1;
+  for (size_t j = 0; j < k && out < k; ++j) {
+    if (j == self) continue;
+    row[out] = cand[j].second;
+    row_d2[out] = static_cast<float>(cand[j].first);
+    ++out;
+  }
+}
+
+constexpr int kCoordBits = 21;  // cells per axis < 2^21
+constexpr int64_t kCoordLimit = int64_t{1} << kCoordBits;
+constexpr uint64_t kEmptySlot = ~uint64_t{0};
+// Beyond this many rings of cells a query falls back to the k-d tree (a point far from all others).
+constexpr int kMaxRing = 6;
+
+}  // namespace
+
+struct PointGrid::Impl {
+  const std::vector<Vec3>& pts;
+  double cell = 1, inv = 1;
+  Vec3 origin = Vec3::Zero();
+  std::vector<Vec3> sorted;              // the points cell by cell
+  std::vector<uint32_t> sorted_index;    // their indices in `pts`
+  std::vector<uint32_t> cell_start;      // cell c holds sorted[cell_start[c] .. cell_start[c+1])
+  std::vector<Eigen::Vector3i> cell_coord;
+  std::vector<uint64_t> slot_key;        // open addressing: packed cell coordinates -> cell
+  std::vector<uint32_t> slot_cell;
+  int slot_shift = 64;
+  mutable std::once_flag tree_once;
+  mutable std::unique_ptr<KdTree> tree;
+
+  Impl(const std::vector<Vec3>& points, double cell_m) : pts(points) {
+    if (!(cell_m > 0) || !std::isfinite(cell_m))
+      throw InvalidInput("[PointGrid] cell_m must be > 0 (got " + std::to_string(cell_m) + ")");
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const Vec3& p : pts) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    if (pts.empty()) lo = hi = Vec3::Zero();
+    origin = lo;
+    cell = std::max(cell_m, (hi - lo).maxCoeff() / static_cast<double>(kCoordLimit - 2));
+    inv = 1.0 / cell;
+
+    size_t slots = 16;
+    while (slots < 2 * pts.size()) slots *= 2;
+    slot_shift = 64 - static_cast<int>(std::log2(static_cast<double>(slots)) + 0.5);
+    slot_key.assign(slots, kEmptySlot);
+    slot_cell.assign(slots, 0);
+    std::vector<uint32_t> cell_of(pts.size());
+    std::vector<uint32_t> count;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const Eigen::Vector3i c = coordOf(pts[i]);
+      const uint64_t key = pack(c);
+      size_t s = slotOf(key);
+      while (slot_key[s] != kEmptySlot && slot_key[s] != key) s = (s + 1) & (slot_key.size() - 1);
+      if (slot_key[s] == kEmptySlot) {
+        slot_key[s] = key;
+        slot_cell[s] = static_cast<uint32_t>(count.size());
+        count.push_back(0);
+        cell_coord.push_back(c);
+      }
+      cell_of[i] = slot_cell[s];
+      ++count[slot_cell[s]];
+    }
+    cell_start.assign(count.size() + 1, 0);
+    for (size_t c = 0; c < count.size(); ++c) cell_start[c + 1] = cell_start[c] + count[c];
+    sorted.resize(pts.size());
+    sorted_index.resize(pts.size());
+    std::vector<uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const uint32_t at = fill[cell_of[i]]++;
+      sorted[at] = pts[i];
+      sorted_index[at] = static_cast<uint32_t>(i);
+    }
+  }
+
+  Eigen::Vector3i coordOf(const Vec3& p) const {
+    Eigen::Vector3i c;
+    for (int a = 0; a < 3; ++a) {
+      const double v = std::floor((p[a] - origin[a]) * inv);
+      c[a] = static_cast<int>(std::max(-1e9, std::min(1e9, v)));
+    }
+    return c;
+  }
+  static uint64_t pack(const Eigen::Vector3i& c) {
+    return static_cast<uint64_t>(c.x()) | (static_cast<uint64_t>(c.y()) << kCoordBits) |
+           (static_cast<uint64_t>(c.z()) << (2 * kCoordBits));
+  }
+  size_t slotOf(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> slot_shift); }
+  // The cell at c, or -1 when no point lies there.
+  long find(const Eigen::Vector3i& c) const {
+    for (int a = 0; a < 3; ++a)
+      if (c[a] < 0 || c[a] >= kCoordLimit) return -1;
+    const uint64_t key = pack(c);
+    for (size_t s = slotOf(key);; s = (s + 1) & (slot_key.size() - 1)) {
+      if (slot_key[s] == key) return slot_cell[s];
+      if (slot_key[s] == kEmptySlot) return -1;
+    }
+  }
+  // Calls f(cell) for every occupied cell whose coordinates differ from c by exactly
+  // `ring` in their largest component (ring 0: c itself).
+  template <class F>
+  void forRing(const Eigen::Vector3i& c, int ring, F&& f) const {
+    for (int dx = -ring; dx <= ring; ++dx)
+      for (int dy = -ring; dy <= ring; ++dy) {
+        const bool side = std::abs(dx) == ring || std::abs(dy) == ring;
+        for (int dz = -ring; dz <= ring; dz += (side || ring == 0) ? 1 : 2 * ring) {
+          const long cell_id = find(c + Eigen::Vector3i(dx, dy, dz));
+          if (cell_id >= 0) f(static_cast<size_t>(cell_id));
+        }
+      }
+  }
+  // Distance from q (in cell c) to the nearest face of its cell.
+  double marginInCell(const Vec3& q, const Eigen::Vector3i& c) const {
+    double m = cell;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = origin[a] + c[a] * cell;
+      m = std::min({m, q[a] - lo, lo + cell - q[a]});
+    }
+    return std::max(0.0, m);
+  }
+  const KdTree& kdTree() const {
+    std::call_once(tree_once, [this] { tree = std::make_unique<KdTree>(pts); });
+    return *tree;
+  }
+
+  // The k nearest to q into cand's front, sorted; false when it took the k-d tree
+  // (then idx/d2 hold the answer instead).
+  void nearest(const Vec3& q, size_t k, std::vector<Candidate>& cand, std::vector<uint32_t>& idx,
+               std::vector<double>& d2) const {
+    cand.clear();
+    const Eigen::Vector3i c = coordOf(q);
+    auto add = [&](size_t cell_id) {
+      for (uint32_t j = cell_start[cell_id]; j < cell_start[cell_id + 1]; ++j)
+        cand.emplace_back((sorted[j] - q).squaredNorm(), sorted_index[j]);
+    };
+    const double margin = marginInCell(q, c);
+    for (int ring = 0;; ++ring) {
+      forRing(c, ring, add);
+      // Every point within this distance of q is in the rings visited so far.
+      const double sure = static_cast<double>(ring) * cell + margin;
+      if (cand.size() >= k) {
+        std::nth_element(cand.begin(), cand.begin() + static_cast<long>(k - 1), cand.end());
+        if (cand[k - 1].first <= sure * sure || cand.size() == pts.size()) break;
+      }
+      if (ring >= kMaxRing) {
+        kdTree().nearest(q, k, idx, d2);
+        cand.clear();
+        for (size_t j = 0; j < idx.size(); ++j) cand.emplace_back(d2[j], idx[j]);
+        std::sort(cand.begin(), cand.end());
+        return;
+      }
+    }
+    keepNearest(cand, k);
+  }
+};
+
+PointGrid::PointGrid(const std::vector<Vec3>& points, double cell_m)
+    : impl_(std::make_unique<Impl>(points, cell_m)) {}
+PointGrid::~PointGrid() = default;
+
+double PointGrid::cellSize() const { return impl_->cell; }
+
+void PointGrid::nearest(const Vec3& q, size_t k, std::vector<uint32_t>& indices, std::vector<double>& dist2) const {
+  k = std::min(k, impl_->pts.size());
+  thread_local std::vector<Candidate> cand;
+  if (k == 0) {
+    indices.clear();
+    dist2.clear();
+    return;
+  }
+  impl_->nearest(q, k, cand, indices, dist2);
+  indices.resize(k);
+  dist2.resize(k);
+  for (size_t j = 0; j < k; ++j) {
+    indices[j] = cand[j].second;
+    dist2[j] = cand[j].first;
+  }
+}
+
+void PointGrid::withinRadius(const Vec3& q, double radius_m, std::vector<uint32_t>& indices,
+                             std::vector<double>& dist2, std::vector<Vec3>* points) const {
+  indices.clear();
+  dist2.clear();
+  if (points) points->clear();
+  if (!(radius_m >= 0)) return;
+  const double r2 = radius_m * radius_m;
+  const Impl& g = *impl_;
+  auto add = [&](size_t cell_id) {
+    for (uint32_t j = g.cell_start[cell_id]; j < g.cell_start[cell_id + 1]; ++j) {
+      const double d = (g.sorted[j] - q).squaredNorm();
+      if (d <= r2) {
+        indices.push_back(g.sorted_index[j]);
+        dist2.push_back(d);
+        if (points) points->push_back(g.sorted[j]);
+      }
+    }
+  };
+  const double rings = std::ceil(radius_m * g.inv);
+  const size_t cells = g.cell_start.size() - 1;
+  if (rings > 64 || std::pow(2 * rings + 1, 3) > static_cast<double>(cells)) {
+    for (size_t c = 0; c < cells; ++c) add(c);
+    return;
+  }
+  const Eigen::Vector3i c = g.coordOf(q);
+  for (int ring = 0; ring <= static_cast<int>(rings); ++ring) g.forRing(c, ring, add);
+}
+
+void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progress) const {
+  const Impl& g = *impl_;
+  if (k < 1 || g.pts.size() < k)
+    throw InvalidInput("[PointGrid::fillTable] k = " + std::to_string(k) + " needs 1 <= k <= " +
+                       std::to_string(g.pts.size()) + " points");
+  table.k = k;
+  table.index.resize(g.pts.size() * k);
+  table.dist2.resize(g.pts.size() * k);
+  const long cells = static_cast<long>(g.cell_start.size() - 1);
+  const long block = std::max<long>(256, cells / 16);
+  for (long first = 0; first < cells; first += block) {
+    const long last = std::min(cells, first + block);
+#pragma omp parallel
+    {
+      // Each cell's points share the candidates of the 27 cells around it: every
+      // point within one cell width of any of them.
+      std::vector<Vec3> near_pts;
+      std::vector<uint32_t> near_idx;
+      std::vector<Candidate> cand;
+      std::vector<uint32_t> idx;
+      std::vector<double> d2;
+#pragma omp for schedule(dynamic, 16)
+      for (long c = first; c < last; ++c) {
+        near_pts.clear();
+        near_idx.clear();
+        g.forRing(g.cell_coord[static_cast<size_t>(c)], 0, [&](size_t id) {
+          near_pts.insert(near_pts.end(), g.sorted.begin() + g.cell_start[id], g.sorted.begin() + g.cell_start[id + 1]);
+          near_idx.insert(near_idx.end(), g.sorted_index.begin() + g.cell_start[id],
+                          g.sorted_index.begin() + g.cell_start[id + 1]);
+        });
+        g.forRing(g.cell_coord[static_cast<size_t>(c)], 1, [&](size_t id) {
+          near_pts.insert(near_pts.end(), g.sorted.begin() + g.cell_start[id], g.sorted.begin() + g.cell_start[id + 1]);
+          near_idx.insert(near_idx.end(), g.sorted_index.begin() + g.cell_start[id],
+                          g.sorted_index.begin() + g.cell_start[id + 1]);
+        });
+        const Eigen::Vector3i& coord = g.cell_coord[static_cast<size_t>(c)];
+        const bool everything = near_pts.size() == g.pts.size();
+        for (uint32_t s = g.cell_start[static_cast<size_t>(c)]; s < g.cell_start[static_cast<size_t>(c) + 1]; ++s) {
+          const Vec3& q = g.sorted[s];
+          const uint32_t i = g.sorted_index[s];
+          // Every point this close to q is among the candidates: when k of them are,
+          // they are the k nearest.
+          const double sure = g.cell + g.marginInCell(q, coord);
+          const double sure2 = everything ? std::numeric_limits<double>::infinity() : sure * sure;
+          cand.clear();
+          for (size_t j = 0; j < near_pts.size(); ++j) {
+            const double d = (near_pts[j] - q).squaredNorm();
+            if (d <= sure2) cand.emplace_back(d, near_idx[j]);
+          }
+          if (cand.size() >= k)
+            keepNearest(cand, k);
+          else
+            g.nearest(q, k, cand, idx, d2);
+          writeRow(cand, k, i, table.index.data() + static_cast<size_t>(i) * k,
+                   table.dist2.data() + static_cast<size_t>(i) * k);
+        }
+      }
+    }
+    progress("neighbours", static_cast<double>(last) / static_cast<double>(cells));
+  }
+}
+
+std::unique_ptr<PointGrid> gridForNeighbours(const std::vector<Vec3>& points, size_t k) {
+  k = std::max<size_t>(1, k);
+  // First guess: the points spread over the bounding box's largest face.
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  if (points.size() < 2) return std::make_unique<PointGrid>(points, 1.0);
+  Vec3 e = hi - lo;
+  std::sort(e.data(), e.data() + 3);
+  const double area = std::max({e[2] * e[1], 1e-6 * e[2] * e[2], 1e-12});
+  const double density = static_cast<double>(points.size()) / area;
+  const double guess = 1.5 * std::sqrt(static_cast<double>(k) / (M_PI * density));
+  auto grid = std::make_unique<PointGrid>(points, guess);
+  const double median = medianNeighbourDistance(*grid, points, std::min(k, points.size()), 64);
+  const double cell = 1.5 * median;
+  if (cell > 0 && (cell < 0.7 * grid->cellSize() || cell > 1.4 * grid->cellSize()))
+    grid = std::make_unique<PointGrid>(points, cell);
+  return grid;
+}
+
 NeighbourTable nearestNeighbours(const std::vector<Vec3>& points, size_t k, const Progress& progress) {
   if (k < 1) throw InvalidInput("[nearestNeighbours] k must be >= 1 (got 0)");
   if (points.size() < k)
     throw InvalidInput("[nearestNeighbours] cloud has " + std::to_string(points.size()) +
                        " points, fewer than k = " + std::to_string(k));
-  KdTree tree(points);
   NeighbourTable table;
-  table.k = k;
-  table.index.resize(points.size() * k);
-  table.dist2.resize(points.size() * k);
-  const long n = static_cast<long>(points.size());
-  const long chunk = 8192;
-  for (long start = 0; start < n; start += chunk) {
-    const long end = std::min(n, start + chunk);
-#pragma omp parallel
-    {
-      std::vector<uint32_t> idx;
-      std::vector<double> d2;
-#pragma omp for schedule(static)
-      for (long i = start; i < end; ++i) {
-        tree.nearest(points[i], k, idx, d2);
-        // Duplicate points can push the query point itself out of slot 0; put it back.
-        auto self = std::find(idx.begin(), idx.end(), static_cast<uint32_t>(i));
-        if (self == idx.end()) {
-          idx.back() = static_cast<uint32_t>(i);
-          d2.back() = 0.0;
-          self = idx.end() - 1;
-        }
-        std::rotate(idx.begin(), self, self + 1);
-        std::rotate(d2.begin(), d2.begin() + (self - idx.begin()), d2.begin() + (self - idx.begin()) + 1);
-        for (size_t j = 0; j < k; ++j) {
-          table.index[i * k + j] = idx[j];
-          table.dist2[i * k + j] = static_cast<float>(d2[j]);
-        }
-      }
-    }
-    progress("neighbours", static_cast<double>(end) / static_cast<double>(n));
-  }
+  gridForNeighbours(points, k)->fillTable(table, k, progress);
   return table;
+}
+
+NeighbourTable subsetTable(const NeighbourTable& table, const std::vector<Vec3>& points,
+                           const std::vector<uint32_t>& kept, size_t k) {
+  if (k < 1 || k > table.k || k > kept.size())
+    throw InvalidInput("[subsetTable] k = " + std::to_string(k) + " needs 1 <= k <= the table's " +
+                       std::to_string(table.k) + " columns and the " + std::to_string(kept.size()) + " kept points");
+  if (table.size() != points.size())
+    throw InvalidInput("[subsetTable] the table has " + std::to_string(table.size()) + " rows for " +
+                       std::to_string(points.size()) + " points");
+  constexpr uint32_t kGone = std::numeric_limits<uint32_t>::max();
+  std::vector<uint32_t> renumber(points.size(), kGone);
+  for (size_t j = 0; j < kept.size(); ++j) {
+    if (kept[j] >= points.size() || (j > 0 && kept[j] <= kept[j - 1]))
+      throw InvalidInput("[subsetTable] kept indices must be ascending and below " + std::to_string(points.size()) +
+                         " (got " + std::to_string(kept[j]) + " at position " + std::to_string(j) + ")");
+    renumber[kept[j]] = static_cast<uint32_t>(j);
+  }
+  NeighbourTable sub;
+  sub.k = k;
+  sub.index.resize(kept.size() * k);
+  sub.dist2.resize(kept.size() * k);
+  std::vector<uint32_t> short_rows;
+  for (size_t j = 0; j < kept.size(); ++j) {
+    const uint32_t* row = table.row(kept[j]);
+    const float* d2 = table.rowDist2(kept[j]);
+    size_t out = 0;
+    for (size_t c = 0; c < table.k && out < k; ++c)
+      if (renumber[row[c]] != kGone) {
+        sub.index[j * k + out] = renumber[row[c]];
+        sub.dist2[j * k + out] = d2[c];
+        ++out;
+      }
+    if (out < k) short_rows.push_back(static_cast<uint32_t>(j));
+  }
+  if (!short_rows.empty()) {
+    // Removed neighbours left these rows short: search the sub-cloud itself.
+    std::vector<Vec3> sub_points(kept.size());
+    for (size_t j = 0; j < kept.size(); ++j) sub_points[j] = points[kept[j]];
+    const auto grid = gridForNeighbours(sub_points, k);
+    std::vector<Candidate> cand;
+    std::vector<uint32_t> idx;
+    std::vector<double> d2;
+    for (uint32_t j : short_rows) {
+      grid->nearest(sub_points[j], k, idx, d2);
+      cand.resize(k);
+      for (size_t c = 0; c < k; ++c) cand[c] = {d2[c], idx[c]};
+      writeRow(cand, k, j, sub.index.data() + j * k, sub.dist2.data() + j * k);
+    }
+  }
+  return sub;
 }
 
 double medianSpacing(const NeighbourTable& table) {
@@ -108,18 +443,29 @@ double medianSpacing(const NeighbourTable& table) {
   return std::sqrt(static_cast<double>(d[d.size() / 2]));
 }
 
-double medianNeighbourDistance(const KdTree& tree, const std::vector<Vec3>& points, size_t k, size_t samples) {
+namespace {
+template <class Search>
+double medianKthDistance(const Search& search, const std::vector<Vec3>& points, size_t k, size_t samples) {
   if (points.size() < 2 || k < 2) return 0.0;
   std::vector<double> d;
   std::vector<uint32_t> idx;
   std::vector<double> d2;
   const size_t step = std::max<size_t>(1, points.size() / std::max<size_t>(1, samples));
   for (size_t i = 0; i < points.size(); i += step) {
-    tree.nearest(points[i], k, idx, d2);
+    search.nearest(points[i], k, idx, d2);
     d.push_back(std::sqrt(d2.back()));
   }
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
   return d[d.size() / 2];
+}
+}  // namespace
+
+double medianNeighbourDistance(const KdTree& tree, const std::vector<Vec3>& points, size_t k, size_t samples) {
+  return medianKthDistance(tree, points, k, samples);
+}
+
+double medianNeighbourDistance(const PointGrid& grid, const std::vector<Vec3>& points, size_t k, size_t samples) {
+  return medianKthDistance(grid, points, k, samples);
 }
 
 Eigen::Vector3i voxelOf(const Vec3& p, double size) {

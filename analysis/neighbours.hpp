@@ -41,8 +41,53 @@ struct NeighbourTable {
   const float* rowDist2(size_t i) const { return dist2.data() + i * k; }
 };
 
+// The same queries as KdTree from a uniform grid of cubic cells `cell_m` wide, each
+// cell's points stored together: on a scanned surface with cells about the
+// k-th neighbour distance wide a query reads a few hundred points from nine or
+// so cells instead of walking a tree, several times faster. Exact (rings of
+// cells are added until no closer point can remain); ties go to the lower index.
+class PointGrid {
+ public:
+  // Keeps a reference to `points`: they must outlive the grid and not change.
+  // Throws InvalidInput when cell_m is not > 0.
+  PointGrid(const std::vector<Vec3>& points, double cell_m);
+  ~PointGrid();
+  PointGrid(const PointGrid&) = delete;
+  PointGrid& operator=(const PointGrid&) = delete;
+
+  double cellSize() const;
+  // Same contract as KdTree::nearest.
+  void nearest(const Vec3& q, size_t k, std::vector<uint32_t>& indices, std::vector<double>& dist2) const;
+  // Every point within `radius_m` of q, in the grid's storage order (not sorted;
+  // the same order every run); with `points`, their coordinates too (read from
+  // the grid's cell-ordered copy, cheaper than gathering them by index).
+  void withinRadius(const Vec3& q, double radius_m, std::vector<uint32_t>& indices, std::vector<double>& dist2,
+                    std::vector<Vec3>* points = nullptr) const;
+  // Row i of `table` (k columns) for every point i of the grid's own cloud, as
+  // nearestNeighbours() lays it out.
+  void fillTable(NeighbourTable& table, size_t k, const Progress& progress) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A grid over `points` with cells about 1.5 × the median distance to the k-th
+// neighbour wide (estimated from a sample), the width k-nearest queries run fastest at.
+std::unique_ptr<PointGrid> gridForNeighbours(const std::vector<Vec3>& points, size_t k);
+
+// The k nearest neighbours of every point (see NeighbourTable), from a PointGrid.
 // Throws InvalidInput when k < 1 or the cloud has fewer than k points.
 NeighbourTable nearestNeighbours(const std::vector<Vec3>& points, size_t k, const Progress& progress = {});
+
+// The table of the sub-cloud {points[kept[0]], points[kept[1]], ...} (`kept`
+// ascending, indices into `points`) with k columns, from `table` of the whole
+// cloud: each row keeps its kept neighbours in order; a row left with fewer than
+// k is searched again. The same rows nearestNeighbours() gives on the sub-cloud.
+// Throws InvalidInput when k exceeds table.k or the sub-cloud, or `kept` is not
+// ascending within the table.
+NeighbourTable subsetTable(const NeighbourTable& table, const std::vector<Vec3>& points,
+                           const std::vector<uint32_t>& kept, size_t k);
 
 // Median distance from each point to its nearest other point, m (0 for < 2 points).
 double medianSpacing(const NeighbourTable& table);
@@ -50,6 +95,7 @@ double medianSpacing(const NeighbourTable& table);
 // Median distance to the k-th nearest point (the point itself counts as the
 // first), over about `samples` points spread through `points`, m.
 double medianNeighbourDistance(const KdTree& tree, const std::vector<Vec3>& points, size_t k, size_t samples = 512);
+double medianNeighbourDistance(const PointGrid& grid, const std::vector<Vec3>& points, size_t k, size_t samples = 512);
 
 // Integer cell of a uniform grid of cubes `size` metres wide, and a hash of it.
 Eigen::Vector3i voxelOf(const Vec3& p, double size);

@@ -17,11 +17,15 @@ struct SmoothingParams {
   // over 10 % of a short chord, while a sail curves too gently to be flattened.
   int k_neighbours = 200;
   int polynomial_order = 2;     // 1: plane, 2: quadratic
-  // 0: a local surface fitted at every point (MLS proper). > 0: surfaces fitted
-  // at anchors about anchor_ratio × the neighbourhood radius apart, each point
-  // projected onto a blend of its nearest anchors' (several times faster, a
-  // little less precise at edges and corners).
-  double anchor_ratio = 0.0;
+  // 0: a local surface fitted at every point (MLS proper). > 0: inside the
+  // surface, quadratics fitted at anchors about anchor_ratio × the
+  // neighbourhood radius apart, each point projected onto a blend of its
+  // nearest anchors' (the quadratic carries the curvature across the gap);
+  // near edges, where neighbourhoods turn one-sided, and for plane fits
+  // (polynomial_order 1), every point still gets its own fit. At 0.5, 5-6
+  // times fewer fits; points land within ~0.1 mm RMS (< 1 mm max) of plain MLS
+  // under 4 mm noise.
+  double anchor_ratio = 0.5;
   double good_m = 0.004;        // sensor random error σ (SPEC §3)
   double fair_m = 0.009;        // σ + systematic error: 9 mm at model scale, 14 mm full scale
 };
@@ -33,6 +37,7 @@ struct Smoothing {
   double rms_displacement_m = 0;
   double max_displacement_m = 0;
   double mean_radius_m = 0;           // mean neighbourhood radius used
+  size_t fitted_surfaces = 0;         // local surfaces fitted (every point's without anchors)
   std::vector<std::string> warnings;
 };
 

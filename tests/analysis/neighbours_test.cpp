@@ -180,6 +180,160 @@ TEST(NearestNeighbours, RejectsKZeroAndCloudsSmallerThanK) {
   EXPECT_EQ(nearestNeighbours(pts, 9).size(), 9u);  // exactly k points is enough
 }
 
+// Brute-force k nearest of q: (squared distance, index), closest first, ties by index.
+std::vector<std::pair<double, uint32_t>> bruteNearest(const std::vector<Vec3>& pts, const Vec3& q, size_t k) {
+  std::vector<std::pair<double, uint32_t>> all;
+  for (uint32_t j = 0; j < pts.size(); ++j) all.emplace_back((pts[j] - q).squaredNorm(), j);
+  std::sort(all.begin(), all.end());
+  all.resize(std::min(k, all.size()));
+  return all;
+}
+
+// A noisy curved sheet (1.5 m × 1 m, bent 0.2 m deep, σ = 4 mm) plus a few far strays.
+std::vector<Vec3> sheetWithStrays(size_t n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::normal_distribution<double> N(0.0, kSigma);
+  std::vector<Vec3> pts;
+  for (size_t i = 0; i < n; ++i) {
+    const double x = 1.5 * U(rng), y = U(rng);
+    pts.emplace_back(x, y, 0.2 * std::sin(M_PI * x / 1.5) + N(rng));
+  }
+  pts.emplace_back(5.0, 5.0, 5.0);  // far from everything: many empty rings of cells
+  pts.emplace_back(-3.0, 0.5, 0.0);
+  return pts;
+}
+
+TEST(PointGrid, NearestMatchesABruteForceSearchAtAnyCellWidth) {
+  const std::vector<Vec3> pts = sheetWithStrays(3000, 21);
+  std::mt19937 rng(22);
+  std::uniform_real_distribution<double> U(-0.5, 2.0);
+  // Cells far narrower and far wider than the neighbour distances: still exact.
+  for (double cell : {0.004, 0.03, 0.5}) {
+    const PointGrid g(pts, cell);
+    EXPECT_DOUBLE_EQ(g.cellSize(), cell);
+    std::vector<uint32_t> idx;
+    std::vector<double> d2;
+    for (int t = 0; t < 200; ++t) {
+      // Queries on cloud points, between them and outside the cloud's box.
+      const Vec3 q = t % 3 == 0 ? pts[static_cast<size_t>(t) * 7] : Vec3(U(rng), U(rng), U(rng));
+      for (size_t k : {size_t{1}, size_t{12}, size_t{60}}) {
+        g.nearest(q, k, idx, d2);
+        const auto expected = bruteNearest(pts, q, k);
+        ASSERT_EQ(idx.size(), k);
+        ASSERT_EQ(d2.size(), k);
+        for (size_t j = 0; j < k; ++j) {
+          EXPECT_EQ(idx[j], expected[j].second) << "cell " << cell << " query " << t << " k " << k << " col " << j;
+          EXPECT_DOUBLE_EQ(d2[j], expected[j].first);
+        }
+      }
+    }
+    // The far stray's nearest neighbours come from the other end of the cloud.
+    g.nearest(pts[pts.size() - 2], 3, idx, d2);
+    EXPECT_EQ(idx[0], pts.size() - 2);
+    EXPECT_EQ(idx[1], bruteNearest(pts, pts[pts.size() - 2], 2)[1].second);
+  }
+}
+
+TEST(PointGrid, WithinRadiusFindsExactlyThePointsInTheBall) {
+  const std::vector<Vec3> pts = sheetWithStrays(3000, 23);
+  const PointGrid g(pts, 0.05);
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  for (double r : {0.0, 0.02, 0.07, 0.3, 10.0}) {
+    for (size_t t = 0; t < pts.size(); t += 97) {
+      g.withinRadius(pts[t], r, idx, d2);
+      std::set<uint32_t> expected;
+      for (uint32_t j = 0; j < pts.size(); ++j)
+        if ((pts[j] - pts[t]).squaredNorm() <= r * r) expected.insert(j);
+      EXPECT_EQ(std::set<uint32_t>(idx.begin(), idx.end()), expected) << "radius " << r << " point " << t;
+      ASSERT_EQ(idx.size(), d2.size());
+      for (size_t j = 0; j < idx.size(); ++j) EXPECT_DOUBLE_EQ(d2[j], (pts[idx[j]] - pts[t]).squaredNorm());
+    }
+  }
+  // Asked for, the coordinates come along, row for row.
+  std::vector<Vec3> coords;
+  g.withinRadius(pts[10], 0.07, idx, d2, &coords);
+  ASSERT_EQ(coords.size(), idx.size());
+  for (size_t j = 0; j < idx.size(); ++j) EXPECT_EQ(coords[j], pts[idx[j]]);
+  // The same call gives the same order every time.
+  std::vector<uint32_t> again;
+  g.withinRadius(pts[10], 0.07, idx, d2);
+  g.withinRadius(pts[10], 0.07, again, d2);
+  EXPECT_EQ(idx, again);
+}
+
+TEST(PointGrid, TableMatchesTheKdTreeOnANoisySheet) {
+  const std::vector<Vec3> pts = sheetWithStrays(20000, 24);
+  const KdTree tree(pts);
+  const size_t k = 21;
+  const NeighbourTable table = nearestNeighbours(pts, k);
+  ASSERT_EQ(table.size(), pts.size());
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    tree.nearest(pts[i], k, idx, d2);
+    ASSERT_EQ(table.row(i)[0], i);
+    for (size_t j = 0; j < k; ++j)
+      ASSERT_EQ(table.rowDist2(i)[j], static_cast<float>(d2[j])) << "row " << i << " col " << j;
+  }
+}
+
+TEST(PointGrid, GridForNeighboursSizesCellsByTheKthNeighbourDistance) {
+  // Uniform points at ρ per m²: the k-th neighbour lies near sqrt(k / (π ρ)); the cell
+  // is 1.5 × the sampled median of it (64 samples and edge effects: ±15 %).
+  std::mt19937 rng(25);
+  std::uniform_real_distribution<double> U(0.0, 2.0);
+  std::vector<Vec3> pts(40000);
+  for (Vec3& p : pts) p = Vec3(U(rng), U(rng), 0.0);
+  for (size_t k : {size_t{5}, size_t{30}, size_t{200}}) {
+    const double expected = 1.5 * std::sqrt(static_cast<double>(k) / (M_PI * 10000.0));
+    EXPECT_NEAR(gridForNeighbours(pts, k)->cellSize(), expected, 0.15 * expected) << "k " << k;
+  }
+}
+
+TEST(PointGrid, RejectsANonPositiveCellAndBadTableRequests) {
+  const std::vector<Vec3> pts = grid(4, 0.1);
+  for (double cell : {0.0, -1.0, std::nan("")})
+    expectInvalidInput([&] { PointGrid g(pts, cell); }, {"[PointGrid]", "cell_m must be > 0"});
+  const PointGrid g(pts, 0.1);
+  NeighbourTable table;
+  expectInvalidInput([&] { g.fillTable(table, 0, {}); }, {"[PointGrid::fillTable]", "k = 0"});
+  expectInvalidInput([&] { g.fillTable(table, 17, {}); }, {"[PointGrid::fillTable]", "k = 17", "16 points"});
+  // An empty grid answers nothing.
+  const std::vector<Vec3> none;
+  const PointGrid empty(none, 0.1);
+  std::vector<uint32_t> idx{1};
+  std::vector<double> d2{1.0};
+  empty.nearest(Vec3::Zero(), 3, idx, d2);
+  EXPECT_TRUE(idx.empty());
+  empty.withinRadius(Vec3::Zero(), 1.0, idx, d2);
+  EXPECT_TRUE(idx.empty());
+}
+
+TEST(SubsetTable, MatchesATableBuiltOnTheSubCloud) {
+  const std::vector<Vec3> pts = sheetWithStrays(5000, 26);
+  const NeighbourTable full = nearestNeighbours(pts, 12);
+  // Drop every third point and a solid patch, so some rows run out of kept neighbours.
+  std::vector<uint32_t> kept;
+  std::vector<Vec3> sub_pts;
+  for (uint32_t i = 0; i < pts.size(); ++i) {
+    const bool patch = pts[i].x() > 0.5 && pts[i].x() < 0.55;
+    if (i % 3 == 0 || patch) continue;
+    kept.push_back(i);
+    sub_pts.push_back(pts[i]);
+  }
+  const NeighbourTable sub = subsetTable(full, pts, kept, 6);
+  const NeighbourTable direct = nearestNeighbours(sub_pts, 6);
+  ASSERT_EQ(sub.k, 6u);
+  EXPECT_EQ(sub.index, direct.index);
+  EXPECT_EQ(sub.dist2, direct.dist2);
+
+  expectInvalidInput([&] { subsetTable(full, pts, kept, 13); }, {"[subsetTable]", "k = 13", "12 columns"});
+  expectInvalidInput([&] { subsetTable(full, sub_pts, kept, 6); }, {"[subsetTable]", "rows for"});
+  expectInvalidInput([&] { subsetTable(full, pts, {5, 3}, 1); }, {"[subsetTable]", "ascending", "got 3"});
+}
+
 TEST(MedianSpacing, IsTheGridSpacing) {
   const double h = 0.037;
   const NeighbourTable table = nearestNeighbours(grid(12, h), 5);

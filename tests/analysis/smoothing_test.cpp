@@ -154,6 +154,78 @@ TEST(SmoothMls, PlaneFitsFlattenASphereByTheWeightedCapDepth) {
   EXPECT_NEAR(inward / static_cast<double>(in.size()), expected, 0.1 * expected);
 }
 
+// A 2 m × 1.5 m sheet bent into a cylinder of radius 1.5 m (a sail's curvature),
+// uniform at `density` points/m², Gaussian noise σ along the normal; straight edges
+// and four right-angled corners.
+Cloud noisyCylinderSheet(double density, double sigma, uint32_t seed) {
+  const double R = 1.5;
+  const size_t n = static_cast<size_t>(2.0 * 1.5 * density);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::normal_distribution<double> N(0.0, sigma);
+  Cloud cloud;
+  for (size_t i = 0; i < n; ++i) {
+    const double phi = 2.0 / R * (U(rng) - 0.5), y = 1.5 * U(rng), r = R + N(rng);
+    cloud.points.emplace_back(r * std::sin(phi), y, r * std::cos(phi));
+  }
+  return cloud;
+}
+
+double radialError(const Vec3& p) { return std::hypot(p.x(), p.z()) - 1.5; }
+
+TEST(SmoothMls, AnchoredFitsStayWithinATenthOfSigmaOfPlainMls) {
+  const Cloud in = noisyCylinderSheet(5000, kSigma, 9);
+  SmoothingParams plain;
+  plain.anchor_ratio = 0;
+  const Smoothing exact = smoothMls(in, plain);
+  const Smoothing anchored = smoothMls(in, SmoothingParams{});  // anchor_ratio 0.5 by default
+  ASSERT_EQ(anchored.cloud.size(), in.size());
+  EXPECT_EQ(exact.fitted_surfaces, in.size());
+  // Inside the sheet one fit stands for the points around each anchor (one per cube
+  // half a radius wide); the edge band, about a radius wide and ~30 % of this small
+  // sheet, keeps a fit per point.
+  EXPECT_LT(anchored.fitted_surfaces, in.size() * 6 / 10);
+  EXPECT_GT(anchored.fitted_surfaces, in.size() / 10);
+  // The quadratic carries the surface across half a radius: the two results differ
+  // by a small part of the noise left after smoothing (σ/2 at most, see above).
+  double sum2 = 0, max = 0, err_exact = 0, err_anchored = 0;
+  size_t corner_points = 0;
+  for (size_t i = 0; i < in.size(); ++i) {
+    const double d = (anchored.cloud.points[i] - exact.cloud.points[i]).norm();
+    sum2 += d * d;
+    max = std::max(max, d);
+    err_exact += std::pow(radialError(exact.cloud.points[i]), 2);
+    err_anchored += std::pow(radialError(anchored.cloud.points[i]), 2);
+    // Within 5 cm of a corner: anchors never stand in for these points.
+    const double phi = std::atan2(in.points[i].x(), in.points[i].z());
+    const bool corner = std::abs(std::abs(phi) - 1.0 / 1.5) * 1.5 < 0.05 &&
+                        (in.points[i].y() < 0.05 || in.points[i].y() > 1.45);
+    if (corner) {
+      ++corner_points;
+      EXPECT_EQ(anchored.cloud.points[i], exact.cloud.points[i]) << i;
+    }
+  }
+  EXPECT_GT(corner_points, 20u);
+  EXPECT_LT(std::sqrt(sum2 / static_cast<double>(in.size())), 0.1 * kSigma);
+  EXPECT_LT(max, kSigma / 2);
+  // Against the known surface the anchored result is as good as plain MLS (±10 %).
+  EXPECT_LT(std::sqrt(err_anchored / static_cast<double>(in.size())),
+            1.1 * std::sqrt(err_exact / static_cast<double>(in.size())));
+  EXPECT_NEAR(anchored.mean_radius_m, exact.mean_radius_m, 0.02 * exact.mean_radius_m);
+}
+
+TEST(SmoothMls, GivesTheSameResultEveryRun) {
+  // Per-point results written by index and sums taken in index order: thread
+  // timing cannot change a bit.
+  const Cloud in = noisyCylinderSheet(3000, kSigma, 10);
+  const Smoothing a = smoothMls(in, SmoothingParams{});
+  const Smoothing b = smoothMls(in, SmoothingParams{});
+  EXPECT_EQ(a.cloud.points, b.cloud.points);
+  EXPECT_EQ(a.displacement_m, b.displacement_m);
+  EXPECT_EQ(a.mean_radius_m, b.mean_radius_m);
+  EXPECT_EQ(a.fitted_surfaces, b.fitted_surfaces);
+}
+
 TEST(SmoothMls, WarnsWhenTooManyPointsMoveBeyondFair) {
   // Classes tighter than the noise: nearly every point of a σ = 4 mm plane moves more
   // than fair_m = 1 mm (|Z| > 0.25 holds for 80 % of a Gaussian).
