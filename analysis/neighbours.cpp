@@ -306,43 +306,54 @@ void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progr
     {
       // Each cell's points share the candidates of the 27 cells around it: every
       // point within one cell width of any of them.
-      std::vector<Vec3> near_pts;
+      std::vector<double> nx, ny, nz, dd;  // candidates' coordinates (vectorisable) and squared distances
       std::vector<uint32_t> near_idx;
       std::vector<Candidate> cand;
       std::vector<uint32_t> idx;
       std::vector<double> d2;
 #pragma omp for schedule(dynamic, 16)
       for (long c = first; c < last; ++c) {
-        near_pts.clear();
+        nx.clear();
+        ny.clear();
+        nz.clear();
         near_idx.clear();
-        g.forRing(g.cell_coord[static_cast<size_t>(c)], 0, [&](size_t id) {
-          near_pts.insert(near_pts.end(), g.sorted.begin() + g.cell_start[id], g.sorted.begin() + g.cell_start[id + 1]);
-          near_idx.insert(near_idx.end(), g.sorted_index.begin() + g.cell_start[id],
-                          g.sorted_index.begin() + g.cell_start[id + 1]);
-        });
-        g.forRing(g.cell_coord[static_cast<size_t>(c)], 1, [&](size_t id) {
-          near_pts.insert(near_pts.end(), g.sorted.begin() + g.cell_start[id], g.sorted.begin() + g.cell_start[id + 1]);
-          near_idx.insert(near_idx.end(), g.sorted_index.begin() + g.cell_start[id],
-                          g.sorted_index.begin() + g.cell_start[id + 1]);
-        });
+        auto gather = [&](size_t id) {
+          for (uint32_t j = g.cell_start[id]; j < g.cell_start[id + 1]; ++j) {
+            nx.push_back(g.sorted[j].x());
+            ny.push_back(g.sorted[j].y());
+            nz.push_back(g.sorted[j].z());
+            near_idx.push_back(g.sorted_index[j]);
+          }
+        };
         const Eigen::Vector3i& coord = g.cell_coord[static_cast<size_t>(c)];
-        const bool everything = near_pts.size() == g.pts.size();
+        g.forRing(coord, 0, gather);
+        g.forRing(coord, 1, gather);
+        const size_t m = near_idx.size();
+        dd.resize(m);
+        const bool everything = m == g.pts.size();
         for (uint32_t s = g.cell_start[static_cast<size_t>(c)]; s < g.cell_start[static_cast<size_t>(c) + 1]; ++s) {
           const Vec3& q = g.sorted[s];
           const uint32_t i = g.sorted_index[s];
-          // Every point this close to q is among the candidates: when k of them are,
-          // they are the k nearest.
+          const double qx = q.x(), qy = q.y(), qz = q.z();
+          for (size_t j = 0; j < m; ++j)
+            dd[j] = (nx[j] - qx) * (nx[j] - qx) + (ny[j] - qy) * (ny[j] - qy) + (nz[j] - qz) * (nz[j] - qz);
+          // Every point within `sure` of q is among the candidates: when k of them
+          // are, they are the k nearest. A tighter limit first (most points' k-th
+          // neighbour lies well inside it) leaves fewer to select from.
           const double sure = g.cell + g.marginInCell(q, coord);
           const double sure2 = everything ? std::numeric_limits<double>::infinity() : sure * sure;
-          cand.clear();
-          for (size_t j = 0; j < near_pts.size(); ++j) {
-            const double d = (near_pts[j] - q).squaredNorm();
-            if (d <= sure2) cand.emplace_back(d, near_idx[j]);
+          bool done = false;
+          for (double limit2 : {std::min(sure2, 0.7 * g.cell * g.cell), sure2}) {
+            cand.clear();
+            for (size_t j = 0; j < m; ++j)
+              if (dd[j] <= limit2) cand.emplace_back(dd[j], near_idx[j]);
+            if (cand.size() >= k) {
+              keepNearest(cand, k);
+              done = true;
+              break;
+            }
           }
-          if (cand.size() >= k)
-            keepNearest(cand, k);
-          else
-            g.nearest(q, k, cand, idx, d2);
+          if (!done) g.nearest(q, k, cand, idx, d2);
           writeRow(cand, k, i, table.index.data() + static_cast<size_t>(i) * k,
                    table.dist2.data() + static_cast<size_t>(i) * k);
         }
