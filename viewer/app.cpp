@@ -13,6 +13,7 @@
 #include "database/scan_record.hpp"
 #include "database/schema.hpp"
 #include "acquisition/scene.hpp"
+#include "analysis/sail_generator.hpp"
 #include "reports/trim_report.hpp"
 
 namespace sailshape::viewer {
@@ -173,6 +174,7 @@ App::App(std::optional<std::string> database_path) : viewport_(std::make_unique<
 }
 
 App::~App() {
+  live_.mode.stop();
   load_.task.cancel();
   processing_.task.cancel();
   report_.task.cancel();
@@ -219,7 +221,7 @@ bool App::startReport(const std::string& out_path, bool whole_test, const std::s
 
 bool App::busy() const {
   return load_.task.busy() || processing_.task.busy() || report_.task.busy() || scanner_.scan_task.busy() ||
-         scanner_.home_task.busy();
+         scanner_.home_task.busy() || live_.mode.running();
 }
 
 bool App::settled() const {
@@ -269,6 +271,7 @@ void App::selectScan(int64_t scan_id) {
   browser_.selected_scan = scan_id;
   browser_.overlays.erase(scan_id);
   load_.pending_scan = scan_id;
+  live_.shown_sweep = 0;
   if (load_.task.busy()) load_.task.cancel();  // the selection wins over an overlay still loading
   pick_.info.reset();
 }
@@ -327,6 +330,7 @@ void App::pollJobs() {
     }
   }
   startNextLoad();
+  takeLiveResults();
 
   const JobStatus rs = report_.task.status();
   if (rs.state != JobState::Running && rs.state != JobState::Idle && report_.note.empty()) {
@@ -430,8 +434,15 @@ void App::drawToolbar(float x, float y, float w, float h) {
       ImGui::SameLine();
       if (ImGui::Button(label)) view_.camera = preset;
     }
+    ImGui::SameLine();
+    ImGui::BeginDisabled(scanner_.session.units().empty());
+    if (ImGui::Button("Unit")) view_.placement = unitCamera(scanner_.session.units().front().config);
+    ImGui::EndDisabled();
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip("from the first scanner unit (Scanners tab): at its scanner, looking along its sweep's centre");
     ImGui::SameLine(0, 24);
-    ImGui::BeginDisabled(!load_.scene || report_.task.busy());
+    // A live sweep that was not stored has no scan to report on.
+    ImGui::BeginDisabled(!load_.scene || load_.scene->record.scan_id == 0 || report_.task.busy());
     if (ImGui::Button(report_.task.busy() ? "Writing report…" : "Report (PDF)")) {
       report_.popup = true;
       const ScanRecord& r = load_.scene->record;
@@ -522,6 +533,8 @@ void App::drawDisplayOptions() {
   changed |= ImGui::Checkbox("flying surface", &o.surface);
   ImGui::SameLine();
   changed |= ImGui::Checkbox("raw cloud", &o.cloud);
+  changed |= ImGui::Checkbox("sail cluster", &o.cluster);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("the points segmentation took for the sail, cleaned and smoothed");
   changed |= ImGui::Checkbox("sections", &o.sections);
   ImGui::SameLine();
   changed |= ImGui::Checkbox("design sections", &o.design_sections);
@@ -553,6 +566,10 @@ void App::drawView(float x, float y, float w, float h) {
     if (view_.camera) {
       viewport_->setCamera(*view_.camera);
       view_.camera.reset();
+    }
+    if (view_.placement) {
+      viewport_->setCamera(*view_.placement);
+      view_.placement.reset();
     }
     view_.hovered = false;
     // A zero-size view (tiny window, minimised) renders nothing and keeps VTK's last framebuffer.
@@ -611,12 +628,13 @@ void App::drawView(float x, float y, float w, float h) {
         const ScanRecord& r = load_.scene->record;
         std::string title = r.campaign + " · " + (r.test.empty() ? "" : r.test + " · ") + "step " +
                             std::to_string(r.step) + " · " + r.sail;
+        if (live_.shown_sweep) title = "LIVE sweep " + std::to_string(live_.shown_sweep) + " · " + title;
         if (r.awa_deg) title += " · AWA " + format("%.0f°", *r.awa_deg);
         dl->AddText(ImVec2(origin.x + 12, ty), IM_COL32(255, 210, 90, 255), title.c_str());
         ty += 22;
         if (!load_.scene->design.empty()) legend(kDesignColour, "design");
         if (!load_.scene->surface.empty() || !load_.scene->raw_cloud.empty())
-          legend(kFlyingColour, "flying, scan " + std::to_string(r.scan_id));
+          legend(kFlyingColour, r.scan_id ? "flying, scan " + std::to_string(r.scan_id) : std::string("flying, not stored"));
         for (const auto& ov : overlayList())
           legend(toU32(ov.colour), "step " + std::to_string(ov.scene->record.step) + ", scan " +
                                        std::to_string(ov.scene->record.scan_id));
@@ -713,7 +731,9 @@ void App::drawRightPanel(float x, float y, float w, float h) {
         drawProcessing();
         ImGui::EndTabItem();
       }
-      if (ImGui::BeginTabItem("Scanners")) {
+      const ImGuiTabItemFlags scanner_flags = select_scanner_tab_ ? ImGuiTabItemFlags_SetSelected : 0;
+      select_scanner_tab_ = false;
+      if (ImGui::BeginTabItem("Scanners", nullptr, scanner_flags)) {
         drawScanner();
         ImGui::EndTabItem();
       }
@@ -975,9 +995,168 @@ void App::drawProcessing() {
   }
 }
 
+TrimStepForm App::trimStepForm() const {
+  const ScannerState& sc = scanner_;
+  TrimStepForm form;
+  form.campaign = sc.campaign;
+  form.session = sc.session_name;
+  form.sail = sc.sail;
+  form.test = sc.test;
+  form.step = sc.step;
+  if (sc.has_awa) form.awa_deg = sc.awa_deg;
+  if (sc.has_aws) form.aws_m_s = sc.aws_m_s;
+  if (sc.has_forces) {
+    form.drive_n = sc.drive_n;
+    form.side_n = sc.side_n;
+  }
+  form.controls = sc.controls;
+  return form;
+}
+
+bool App::addEmulatedDeckUnit() {
+  ScannerState& sc = scanner_;
+  try {
+    sc.session.addEmulatedUnit(builtInDeckScene(), "deck", deckUnit());
+    sc.note = "emulated unit on " + sc.session.units().back().config.serial_device + " and port " +
+              std::to_string(sc.session.units().back().config.port);
+    select_scanner_tab_ = true;
+    return true;
+  } catch (const std::exception& e) {
+    sc.note = e.what();
+    log_.error(e.what());
+    return false;
+  }
+}
+
+bool App::startLive() {
+  const ScannerState& sc = scanner_;
+  if (sc.scan_task.busy() || sc.home_task.busy()) {
+    log_.error("live mode: wait until the scan or the homing has ended");
+    return false;
+  }
+  try {
+    LiveParams params;
+    params.form = trimStepForm();
+    SceneOptions options = load_.options;
+    options.analysis = processing_.params.analysis;
+    std::string source;
+    std::optional<Mesh> design;
+    if (database_.db) {
+      try {
+        design = sailDesignMesh(*database_.db, params.form.sail);
+        source = "the design of " + params.form.sail + " in the database";
+      } catch (const std::exception&) {
+        design.reset();  // no stored design for this sail
+      }
+    }
+    const bool all_deck = std::all_of(sc.session.units().begin(), sc.session.units().end(),
+                                      [](const ScannerUnitSlot& u) { return u.origin == "emulated (deck)"; });
+    if (!design && all_deck && !sc.session.units().empty()) {
+      design = generateSailMesh(exampleDesign(SailType::Main));
+      source = "the emulated deck's mainsail (no design of '" + params.form.sail + "' in the database)";
+    }
+    if (design) {
+      options.roi = sailRoi(*design, live_.roi_margin_m);
+      options.analysis = designedSailParams(*design, live_.sections, options.analysis);
+    } else {
+      options.roi = processing_.params.roi;
+      options.analysis.sections.count = live_.sections;
+      source = "no design: the Processing tab's ROI, flying values only";
+    }
+    params.design = std::move(design);
+    params.scene = options;
+    if (live_.save_each) {
+      if (!database_.db) throw InvalidInput("open a database to store the sweeps in");
+      params.save_to = database_.path;
+    }
+    live_.mode.start(sc.session, std::move(params));
+    live_.design_source = source;
+    live_.messages.clear();
+    live_.note = "live mode: sweeping";
+    log_.info("live mode started; ROI and comparison: " + source);
+    return true;
+  } catch (const std::exception& e) {
+    live_.note = e.what();
+    log_.error(std::string("live mode: ") + e.what());
+    return false;
+  }
+}
+
+void App::takeLiveResults() {
+  bool stored = false;
+  for (LiveSweep& s : live_.mode.take()) {
+    const std::string tag = "live sweep " + std::to_string(s.index);
+    if (!s.store_error.empty()) {
+      live_.messages.push_back(tag + " not stored: " + s.store_error);
+      log_.error(live_.messages.back());
+    }
+    stored |= s.scan_id > 0;
+    if (!s.scene) {
+      live_.messages.push_back(tag + ": analysis failed: " + s.error);
+      log_.error(live_.messages.back());
+      continue;
+    }
+    char line[160];
+    std::snprintf(line, sizeof line, "%s: %zu points, %zu sections; swept in %.1f s, analysed in %.1f s", tag.c_str(),
+                  s.points, s.scene->sections.sections.size(), s.sweep_s, s.analysis_s);
+    live_.note = line;
+    log_.info(line);
+    load_.scene = std::move(*s.scene);
+    load_.pending_scan = 0;
+    browser_.selected_scan = s.scan_id;
+    live_.shown_sweep = s.index;
+    pick_.info.reset();
+    view_.rebuild = true;
+  }
+  if (stored && database_.db) {
+    try {
+      browser_.tree = loadCatalogTree(*database_.db);
+    } catch (const std::exception& e) {
+      log_.error(e.what());
+    }
+  }
+}
+
+void App::drawLive() {
+  ImGui::Separator();
+  ImGui::TextColored(kAccentText, "Live mode");
+  helpMarker("the units sweep again and again; each sweep is analysed while the next one runs and the section table, "
+             "plots and 3D view follow");
+  const bool live = live_.mode.running();
+  ImGui::BeginDisabled(live);
+  ImGui::PushItemWidth(110);
+  inputInt("sections##live", &live_.sections, 1, 20);
+  ImGui::SameLine();
+  inputDouble("ROI margin m", &live_.roi_margin_m, 0.05, "%.2f");
+  live_.roi_margin_m = std::max(0.0, live_.roi_margin_m);
+  ImGui::PopItemWidth();
+  ImGui::Checkbox("store every sweep in the database", &live_.save_each);
+  ImGui::EndDisabled();
+  if (!live) {
+    ImGui::BeginDisabled(scanner_.session.units().empty() || scanner_.scan_task.busy() || scanner_.home_task.busy());
+    if (ImGui::Button("Start live", ImVec2(120, 0))) startLive();
+    ImGui::EndDisabled();
+  } else if (ImGui::Button("Stop live", ImVec2(120, 0))) {
+    live_.mode.requestStop();
+  }
+  const LiveStatus st = live_.mode.status();
+  if (st.running || st.swept > 0) {
+    ImGui::SameLine();
+    ImGui::Text("%s · %d swept · %d analysed · %d failed%s", st.stage.c_str(), st.swept, st.analysed, st.failed,
+                st.skipped ? (" · " + std::to_string(st.skipped) + " skipped").c_str() : "");
+  }
+  if (!live_.design_source.empty()) ImGui::TextColored(kMutedText, "ROI and design: %s", live_.design_source.c_str());
+  if (!live_.note.empty()) ImGui::TextWrapped("%s", live_.note.c_str());
+  if (!st.error.empty()) ImGui::TextColored(kErrorText, "%s", st.error.c_str());
+  const size_t first = live_.messages.size() > 4 ? live_.messages.size() - 4 : 0;
+  ImGui::PushTextWrapPos(0);
+  for (size_t i = first; i < live_.messages.size(); ++i) ImGui::TextColored(kErrorText, "%s", live_.messages[i].c_str());
+  ImGui::PopTextWrapPos();
+}
+
 void App::drawScanner() {
   ScannerState& sc = scanner_;
-  const bool running = sc.scan_task.busy() || sc.home_task.busy();
+  const bool running = sc.scan_task.busy() || sc.home_task.busy() || live_.mode.running();
   ImGui::BeginDisabled(running);
   ImGui::SetNextItemWidth(-90);
   ImGui::InputTextWithHint("##unit", "UNIT.json", sc.unit_path, sizeof sc.unit_path);
@@ -991,16 +1170,7 @@ void App::drawScanner() {
       log_.error(e.what());
     }
   }
-  if (ImGui::Button("Add emulated unit (deck scene)")) {
-    try {
-      sc.session.addEmulatedUnit(builtInDeckScene(), "deck", deckUnit());
-      sc.note = "emulated unit on " + sc.session.units().back().config.serial_device + " and port " +
-                std::to_string(sc.session.units().back().config.port);
-    } catch (const std::exception& e) {
-      sc.note = e.what();
-      log_.error(e.what());
-    }
-  }
+  if (ImGui::Button("Add emulated unit (deck scene)")) addEmulatedDeckUnit();
   std::optional<size_t> remove, home;
   for (size_t i = 0; i < sc.session.units().size(); ++i) {
     ScannerUnitSlot& u = sc.session.units()[i];
@@ -1021,6 +1191,8 @@ void App::drawScanner() {
     if (ImGui::Button("Home")) home = i;
     ImGui::SameLine();
     if (ImGui::Button("Remove")) remove = i;
+    ImGui::SameLine();
+    if (ImGui::Button("View from here")) view_.placement = unitCamera(u.config);
     ImGui::PopID();
   }
   if (remove) sc.session.removeUnit(*remove);
@@ -1060,27 +1232,21 @@ void App::drawScanner() {
     sc.preview.reset();
     view_.rebuild = true;
     const ScannerSession* session = &sc.session;
-    sc.scan_task.start("scan", [session](const Progress& p) { return session->scan({}, p); });
+    sc.scan_task.start("scan", [session](const Progress& p) {
+      try {
+        return session->scan({}, p);
+      } catch (const Cancelled&) {
+        session->stopTurntables();  // the drives would refuse the next scan's homing while they still move
+        throw;
+      }
+    });
   }
   ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::BeginDisabled(!sc.last || !database_.db);
   if (ImGui::Button("Save to database", ImVec2(160, 0))) {
     try {
-      TrimStepForm form;
-      form.campaign = sc.campaign;
-      form.session = sc.session_name;
-      form.sail = sc.sail;
-      form.test = sc.test;
-      form.step = sc.step;
-      if (sc.has_awa) form.awa_deg = sc.awa_deg;
-      if (sc.has_aws) form.aws_m_s = sc.aws_m_s;
-      if (sc.has_forces) {
-        form.drive_n = sc.drive_n;
-        form.side_n = sc.side_n;
-      }
-      form.controls = sc.controls;
-      const ImportResult saved = saveAcquisition(*database_.db, *sc.last, form);
+      const ImportResult saved = saveAcquisition(*database_.db, *sc.last, trimStepForm());
       sc.note = "saved as scan " + std::to_string(saved.scan_id);
       log_.info(sc.note);
       sc.last.reset();
@@ -1095,7 +1261,7 @@ void App::drawScanner() {
   }
   ImGui::EndDisabled();
   ImGui::EndDisabled();
-  if (running) {
+  if (sc.scan_task.busy() || sc.home_task.busy()) {
     const JobStatus st = sc.scan_task.busy() ? sc.scan_task.status() : sc.home_task.status();
     ImGui::ProgressBar(static_cast<float>(st.fraction), ImVec2(-80, 0), st.stage.empty() ? st.name.c_str() : st.stage.c_str());
     ImGui::SameLine();
@@ -1111,7 +1277,7 @@ void App::drawScanner() {
       view_.rebuild = true;
     }
   }
-  ImGui::TextColored(kMutedText, "Live mode (sweep after sweep, analysed as they come) is not in this build.");
+  drawLive();
 }
 
 void App::drawReportPopup() {

@@ -15,6 +15,7 @@
 
 #include "database/sqlite.hpp"
 #include "viewer/catalog_tree.hpp"
+#include "viewer/live_mode.hpp"
 #include "viewer/processing.hpp"
 #include "viewer/scanner_session.hpp"
 #include "viewer/scan_scene.hpp"
@@ -73,6 +74,7 @@ struct ViewState {
   ViewOptions options;
   bool rebuild = true;              // actors must be rebuilt before the next render
   std::optional<CameraPreset> camera;
+  std::optional<CameraPlacement> placement;  // the view from a scanner unit, applied on the next frame
   int width = 0, height = 0;        // last rendered size of the 3D view, pixels
   bool hovered = false;
 };
@@ -101,6 +103,18 @@ struct ScannerState {
   std::optional<Acquisition> last;       // the latest scan, not yet saved
   std::optional<StageResult> preview;    // its cloud, shown in the 3D view
   std::string note;
+};
+
+// Live mode (Scanners tab): sweep after sweep, each analysed as it comes and shown.
+struct LiveState {
+  LiveMode mode;
+  int sections = 2;                 // one unit's view of the upper sail holds 2 sections better than 3
+  double roi_margin_m = 0.3;
+  bool save_each = false;           // store every sweep (with its analysis) in the open database
+  std::string design_source;        // where the ROI and the comparison come from
+  int shown_sweep = 0;              // the sweep the panels show (0: they show a stored scan)
+  std::string note;
+  std::vector<std::string> messages;  // failed analyses and stores, newest last
 };
 
 struct MessageLog {
@@ -133,6 +147,17 @@ class App {
     view_.options.deviation = on;
     view_.rebuild = true;
   }
+  const ViewOptions& viewOptions() const { return view_.options; }
+  void setViewOptions(const ViewOptions& options) {
+    view_.options = options;
+    view_.rebuild = true;
+  }
+  // As the Scanners tab's buttons do; false when it could not (the reason goes to the message log).
+  bool addEmulatedDeckUnit();
+  bool startLive();
+  void storeLiveSweeps(bool on) { live_.save_each = on; }
+  void stopLive() { live_.mode.stop(); }
+  LiveStatus liveStatus() const { return live_.mode.status(); }
 
  private:
   void openDatabase(const std::string& path);
@@ -149,6 +174,9 @@ class App {
   void drawTrimComparison();
   void drawProcessing();
   void drawScanner();
+  void drawLive();
+  void takeLiveResults();
+  TrimStepForm trimStepForm() const;
   void drawReportPopup();
   void drawStatus(float x, float y, float w, float h);
   std::vector<Overlay> overlayList() const;
@@ -162,6 +190,8 @@ class App {
   ViewState view_;
   ReportState report_;
   ScannerState scanner_;
+  LiveState live_;
+  bool select_scanner_tab_ = false;
   MessageLog log_;
   std::unique_ptr<VtkViewport> viewport_;
   bool initial_load_done_ = false;

@@ -32,7 +32,25 @@ struct Options {
   bool deviation = false;
   std::vector<float> pick;  // --pick FX,FY: fractions of the 3D view
   std::string report;  // --report: write this PDF once the first scan is loaded (scripted Report button)
+  std::vector<std::string> show;  // --show: what the 3D view draws
+  int live = 0;        // --live N: live mode on an emulated deck unit until N sweeps are analysed
 };
+
+// --show design,surface,cluster,...: exactly these layers in the 3D view.
+ViewOptions shownLayers(ViewOptions o, const std::vector<std::string>& layers) {
+  o.design = o.surface = o.cloud = o.cluster = o.sections = o.design_sections = o.section_planes = false;
+  for (const std::string& l : layers) {
+    if (l == "design") o.design = true;
+    else if (l == "surface") o.surface = true;
+    else if (l == "cloud") o.cloud = true;
+    else if (l == "cluster") o.cluster = true;
+    else if (l == "sections") o.sections = true;
+    else if (l == "design-sections") o.design_sections = true;
+    else if (l == "planes") o.section_planes = true;
+    else throw CLI::ValidationError("--show", "unknown layer '" + l + "' (design, surface, cloud, cluster, sections, design-sections, planes)");
+  }
+  return o;
+}
 
 // GLFW for the process: initialised once, terminated on scope exit.
 struct GlfwLibrary {
@@ -153,9 +171,11 @@ int run(const Options& o) {
 
   App app(o.database);
   if (o.deviation) app.setDeviationView(true);
+  if (!o.show.empty()) app.setViewOptions(shownLayers(app.viewOptions(), o.show));
   const bool shooting = !o.screenshot.empty();
   int counted = 0;
   bool report_started = o.report.empty();
+  bool live_started = o.live == 0, live_printed = o.live == 0;
   bool pick_requested = o.pick.empty(), pick_printed = o.pick.empty();
   const auto started = std::chrono::steady_clock::now();
   bool timed_out = false;
@@ -198,6 +218,24 @@ int run(const Options& o) {
           std::printf("picked nothing\n");
         }
         std::fflush(stdout);
+      }
+      if (!live_started && app.settled()) {
+        live_started = true;
+        app.storeLiveSweeps(app.databaseOpen());
+        if (!app.addEmulatedDeckUnit() || !app.startLive()) return 1;
+        continue;  // count frames once live mode has ended
+      }
+      if (live_started && !live_printed) {
+        const LiveStatus st = app.liveStatus();
+        // Sweeps whose analysis fails do not count: live mode runs on until N are analysed (at most 10·N sweeps).
+        if (st.running && (st.analysed >= o.live || st.swept >= 10 * o.live)) app.stopLive();
+        if (!st.running && app.settled()) {
+          live_printed = true;
+          std::printf("live: %d swept, %d analysed, %d failed%s%s\n", st.swept, st.analysed, st.failed,
+                      st.error.empty() ? "" : ", ended: ", st.error.c_str());
+          std::fflush(stdout);
+        }
+        if (!live_printed) continue;
       }
       if (!report_started && app.settled()) {
         report_started = true;
@@ -248,12 +286,22 @@ int main(int argc, char** argv) {
       ->expected(2)
       ->delimiter(',')
       ->check(CLI::Range(0.0, 1.0));
+  cli.add_option("--show", o.show,
+                 "what the 3D view draws, comma-separated: design, surface, cloud, cluster (the sail points "
+                 "segmentation picked), sections, design-sections, planes (default: design, surface, sections, "
+                 "design-sections)")
+      ->delimiter(',');
+  cli.add_option("--live", o.live,
+                 "with --screenshot: add an emulated deck unit and run live mode (every sweep stored in the open "
+                 "database) until N sweeps are analysed, then count frames")
+      ->check(CLI::Range(1, 20));
   cli.add_flag("--deviation", o.deviation, "start with the flying shape coloured by signed deviation from the design");
   try {
     cli.parse(argc, argv);
     if (!o.screenshot.empty() && o.frames == 0) throw CLI::ValidationError("--screenshot", "needs --frames N");
-    if (o.screenshot.empty() && (o.frames || o.exercise_window || !o.report.empty() || !o.pick.empty()))
-      throw CLI::ValidationError("--frames", "--frames, --exercise-window, --report and --pick need --screenshot");
+    if (o.screenshot.empty() && (o.frames || o.exercise_window || !o.report.empty() || !o.pick.empty() || o.live))
+      throw CLI::ValidationError("--frames", "--frames, --exercise-window, --report, --pick and --live need --screenshot");
+    shownLayers(ViewOptions{}, o.show);
     if (o.exercise_window && o.frames < 16) throw CLI::ValidationError("--exercise-window", "needs --frames >= 16");
   } catch (const CLI::ParseError& e) {
     return cli.exit(e);

@@ -42,6 +42,7 @@ constexpr Rgb kDesignBlue{0.25f, 0.55f, 1.0f};
 constexpr Rgb kFlyingRed{0.86f, 0.13f, 0.10f};
 constexpr Rgb kSectionAmber{1.0f, 0.80f, 0.20f};
 constexpr Rgb kDesignSectionBlue{0.55f, 0.85f, 1.0f};
+constexpr Rgb kClusterGreen{0.20f, 0.90f, 0.50f};
 
 vtkSmartPointer<vtkPolyData> meshPoly(const Mesh& mesh) {
   auto poly = vtkSmartPointer<vtkPolyData>::New();
@@ -354,6 +355,20 @@ void VtkViewport::setScene(const ScanScene* scene, const std::vector<Overlay>& o
       m.picker->AddPickList(a);
       m.pickables.push_back({a, &scene->raw_deviation_m, "stored cloud"});
     }
+    if (o.cluster && scene->analysis && !scene->analysis->sail_cloud.empty()) {
+      const Cloud& sail = scene->analysis->sail_cloud;
+      auto poly = pointPoly(sail.points);
+      auto a = actorOf(poly, kClusterGreen);
+      if (dev && scene->cluster_deviation_m.size() == sail.size()) {
+        attachScalars(poly, scene->cluster_deviation_m, 1000.0, "deviation_mm");
+        useScalars(a, m.deviation_lut, -m.limit_mm, m.limit_mm);
+      }
+      a->GetProperty()->SetPointSize(o.point_size + 1);
+      flat(a);
+      m.add(a);
+      m.picker->AddPickList(a);
+      m.pickables.push_back({a, &scene->cluster_deviation_m, "sail cluster"});
+    }
     if (o.sections) {
       std::vector<const std::vector<Vec3>*> curves;
       for (const auto& s : scene->sections.sections) curves.push_back(&s.curve);
@@ -456,11 +471,23 @@ void VtkViewport::setCamera(CameraPreset preset) {
     case CameraPreset::Bow: dir = Vec3(1, 0, 0.1); break;
   }
   vtkCamera* cam = m.renderer->GetActiveCamera();
+  cam->SetViewAngle(30.0);  // VTK's default; a unit's view widens it
   cam->SetFocalPoint(c.data());
   const Vec3 pos = c + 10.0 * dir.normalized();
   cam->SetPosition(pos.data());
   cam->SetViewUp(up.data());
   m.renderer->ResetCamera();
+  m.renderer->ResetCameraClippingRange();
+}
+
+void VtkViewport::setCamera(const CameraPlacement& c) {
+  Impl& m = *impl_;
+  vtkCamera* cam = m.renderer->GetActiveCamera();
+  cam->SetPosition(c.position.data());
+  cam->SetFocalPoint(c.focal_point.data());
+  cam->SetViewUp(c.view_up.data());
+  cam->SetViewAngle(60.0);  // about what a scanner's fan covers at the sweep's centre
+  m.camera_placed = true;
   m.renderer->ResetCameraClippingRange();
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analysis/cloud.hpp"
+#include "viewer/unit_camera.hpp"
 
 namespace sailshape::viewer {
 
@@ -21,6 +22,7 @@ struct ViewOptions {
   bool design = true;             // blue wireframe
   bool surface = true;            // flying surface
   bool cloud = false;             // raw stored cloud
+  bool cluster = false;           // the sail cluster: the points segmentation picked as the sail (cleaned, smoothed)
   bool sections = true;           // flying section curves
   bool design_sections = true;    // design section curves
   bool section_planes = false;    // translucent planes through each section
@@ -63,6 +65,7 @@ class VtkViewport {
   void setScene(const ScanScene* scene, const std::vector<Overlay>& overlays, const ViewOptions& options,
                 const StageResult* processing = nullptr);
   void setCamera(CameraPreset preset);
+  void setCamera(const CameraPlacement& placement);  // e.g. unitCamera(): the view from a scanner unit
   void resetCamera();
 
   // Renders at width × height pixels; returns the GL texture to show (owned by

@@ -13,6 +13,8 @@
 #include <memory>
 #include <string>
 
+#include "database/scan_record.hpp"
+#include "viewer/catalog_tree.hpp"
 #include "viewer_fixture.hpp"
 
 namespace sailshape::viewer {
@@ -177,6 +179,46 @@ TEST_F(ViewerApp, DeviationColoursAndSurvivingResizeAndMinimise) {
   EXPECT_GT(count(img, kView, reddish) / area(kView), 0.03);
 }
 
+// Live mode as scripted by --live: an emulated deck unit sweeps until two sweeps are analysed, every sweep is
+// stored, and the view shows the last one's sail cluster (--show) against the design.
+TEST_F(ViewerApp, LiveModeShowsEachAnalysedSweepAndStoresIt) {
+  const std::string db = dir_->file("live.sqlite");
+  { Database created = openSailDatabase(db); }
+  const std::string png = dir_->file("live.png");
+  const ViewerRun r = runViewer(*dir_, quote(db) + " --live 2 --show design,cluster,sections,design-sections --screenshot " +
+                                           quote(png) + " --frames 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int swept = 0, analysed = 0, failed = 0;
+  const auto at = r.out.find("live: ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + at, "live: %d swept, %d analysed, %d failed", &swept, &analysed, &failed), 3) << r.out;
+  EXPECT_EQ(analysed, 2);
+  EXPECT_EQ(swept, analysed + failed);
+  // A failed analysis is reported (on stderr as in the panel), never as a crash.
+  if (failed == 0) EXPECT_EQ(r.err, "");
+
+  const Image img = load(png);
+  ASSERT_TRUE(img.rgb);
+  // The sail cluster's green points over the design's blue grid; no flying surface was asked for
+  // (the red left is the legend's swatch).
+  const Pixel green = [](int r, int g, int b) { return g > 150 && g > r + 80 && g > b + 50; };
+  EXPECT_GT(count(img, kView, green) / area(kView), 0.01);
+  EXPECT_GT(count(img, kView, kBlue) / area(kView), 0.002);
+  EXPECT_LT(count(img, kView, kRed) / area(kView), 0.002);
+  // The live sweep's sections against the design's in the plots; the Scanners tab with live mode's status.
+  EXPECT_GT(count(img, kPlots, kRed), 150u);
+  EXPECT_GT(count(img, kPlots, kBlue), 150u);
+  EXPECT_GT(count(img, kAnalysis, kText), 1000u);
+  EXPECT_GT(count(img, kBrowser, kText), 200u) << "the stored sweeps are listed";
+
+  Database stored = openSailDatabase(db);
+  const CatalogTree tree = loadCatalogTree(stored);
+  EXPECT_EQ(tree.scan_count, static_cast<size_t>(swept)) << "every sweep is stored";
+  size_t with_sections = 0;
+  for (int64_t id : tree.scanIds()) with_sections += loadScanRecord(stored, id).sections.sections.size() == 2;
+  EXPECT_EQ(with_sections, static_cast<size_t>(analysed)) << "each analysed sweep with its two sections";
+}
+
 TEST_F(ViewerApp, OpensAnEmptyDatabase) {
   const std::string db = dir_->file("empty.sqlite");
   { Database created = openSailDatabase(db); }
@@ -212,6 +254,12 @@ TEST_F(ViewerApp, RefusesBadOptions) {
   EXPECT_FALSE(std::filesystem::exists(dir_->file("x.png")));
   const ViewerRun bad_pick = runViewer(*dir_, "--pick 2,0.5 --screenshot " + quote(dir_->file("x.png")) + " --frames 2");
   EXPECT_NE(bad_pick.exit_code, 0) << "a pick outside the view";
+  const ViewerRun bad_layer = runViewer(*dir_, "--show design,hull --screenshot " + quote(dir_->file("x.png")) + " --frames 2");
+  EXPECT_NE(bad_layer.exit_code, 0);
+  EXPECT_NE(bad_layer.err.find("unknown layer 'hull'"), std::string::npos) << bad_layer.err;
+  const ViewerRun live_alone = runViewer(*dir_, "--live 2");
+  EXPECT_NE(live_alone.exit_code, 0);
+  EXPECT_NE(live_alone.err.find("--screenshot"), std::string::npos) << live_alone.err;
   const ViewerRun report_alone = runViewer(*dir_, "--report " + quote(dir_->file("x.pdf")));
   EXPECT_NE(report_alone.exit_code, 0);
   EXPECT_NE(report_alone.err.find("--screenshot"), std::string::npos) << report_alone.err;
