@@ -1028,6 +1028,15 @@ bool App::addEmulatedDeckUnit() {
   }
 }
 
+bool App::setUnitCamera(size_t index) {
+  if (index >= scanner_.session.units().size()) {
+    log_.error("camera: no scanner unit " + std::to_string(index + 1));
+    return false;
+  }
+  view_.placement = unitCamera(scanner_.session.units()[index].config);
+  return true;
+}
+
 bool App::startLive() {
   const ScannerState& sc = scanner_;
   if (sc.scan_task.busy() || sc.home_task.busy()) {

@@ -156,6 +156,9 @@ class App {
   bool addEmulatedDeckUnit();
   bool startLive();
   void storeLiveSweeps(bool on) { live_.save_each = on; }
+  void setCamera(CameraPreset preset) { view_.camera = preset; }
+  // The view from scanner unit `index` (Scanners tab); false when there is no such unit.
+  bool setUnitCamera(size_t index);
   void stopLive() { live_.mode.stop(); }
   LiveStatus liveStatus() const { return live_.mode.status(); }
 

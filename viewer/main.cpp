@@ -34,6 +34,7 @@ struct Options {
   std::string report;  // --report: write this PDF once the first scan is loaded (scripted Report button)
   std::vector<std::string> show;  // --show: what the 3D view draws
   int live = 0;        // --live N: live mode on an emulated deck unit until N sweeps are analysed
+  std::string camera;  // --camera: a preset applied before frames are counted
 };
 
 // --show design,surface,cluster,...: exactly these layers in the 3D view.
@@ -176,6 +177,7 @@ int run(const Options& o) {
   int counted = 0;
   bool report_started = o.report.empty();
   bool live_started = o.live == 0, live_printed = o.live == 0;
+  bool camera_set = o.camera.empty();
   bool pick_requested = o.pick.empty(), pick_printed = o.pick.empty();
   const auto started = std::chrono::steady_clock::now();
   bool timed_out = false;
@@ -237,6 +239,17 @@ int run(const Options& o) {
         }
         if (!live_printed) continue;
       }
+      if (!camera_set && app.settled()) {
+        camera_set = true;
+        const std::pair<const char*, CameraPreset> presets[] = {{"3/4", CameraPreset::ThreeQuarter},
+                                                                {"side", CameraPreset::Side},
+                                                                {"top", CameraPreset::Top},
+                                                                {"astern", CameraPreset::Astern},
+                                                                {"bow", CameraPreset::Bow}};
+        for (const auto& [name, preset] : presets)
+          if (o.camera == name) app.setCamera(preset);
+        if (o.camera == "unit" && !app.setUnitCamera(0)) return 1;
+      }
       if (!report_started && app.settled()) {
         report_started = true;
         if (!app.startReport(o.report, false, "designer")) return 1;
@@ -295,12 +308,18 @@ int main(int argc, char** argv) {
                  "with --screenshot: add an emulated deck unit and run live mode (every sweep stored in the open "
                  "database) until N sweeps are analysed, then count frames")
       ->check(CLI::Range(1, 20));
+  cli.add_option("--camera", o.camera,
+                 "with --screenshot: once loaded, view from this preset: 3/4, side, top, astern, bow, or unit (from "
+                 "the first scanner unit, e.g. the one --live adds)")
+      ->check(CLI::IsMember({"3/4", "side", "top", "astern", "bow", "unit"}));
   cli.add_flag("--deviation", o.deviation, "start with the flying shape coloured by signed deviation from the design");
   try {
     cli.parse(argc, argv);
     if (!o.screenshot.empty() && o.frames == 0) throw CLI::ValidationError("--screenshot", "needs --frames N");
-    if (o.screenshot.empty() && (o.frames || o.exercise_window || !o.report.empty() || !o.pick.empty() || o.live))
-      throw CLI::ValidationError("--frames", "--frames, --exercise-window, --report, --pick and --live need --screenshot");
+    if (o.screenshot.empty() && (o.frames || o.exercise_window || !o.report.empty() || !o.pick.empty() || o.live ||
+                                !o.camera.empty()))
+      throw CLI::ValidationError("--frames",
+                                 "--frames, --exercise-window, --report, --pick, --live and --camera need --screenshot");
     shownLayers(ViewOptions{}, o.show);
     if (o.exercise_window && o.frames < 16) throw CLI::ValidationError("--exercise-window", "needs --frames >= 16");
   } catch (const CLI::ParseError& e) {

@@ -180,12 +180,12 @@ TEST_F(ViewerApp, DeviationColoursAndSurvivingResizeAndMinimise) {
 }
 
 // Live mode as scripted by --live: an emulated deck unit sweeps until two sweeps are analysed, every sweep is
-// stored, and the view shows the last one's sail cluster (--show) against the design.
+// stored, and the view, from the unit (--camera unit), shows the last one's sail cluster (--show) against the design.
 TEST_F(ViewerApp, LiveModeShowsEachAnalysedSweepAndStoresIt) {
   const std::string db = dir_->file("live.sqlite");
   { Database created = openSailDatabase(db); }
   const std::string png = dir_->file("live.png");
-  const ViewerRun r = runViewer(*dir_, quote(db) + " --live 2 --show design,cluster,sections,design-sections --screenshot " +
+  const ViewerRun r = runViewer(*dir_, quote(db) + " --live 2 --camera unit --show design,cluster,sections,design-sections --screenshot " +
                                            quote(png) + " --frames 3");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   int swept = 0, analysed = 0, failed = 0;
@@ -202,6 +202,8 @@ TEST_F(ViewerApp, LiveModeShowsEachAnalysedSweepAndStoresIt) {
   // The sail cluster's green points over the design's blue grid; no flying surface was asked for
   // (the red left is the legend's swatch).
   const Pixel green = [](int r, int g, int b) { return g > 150 && g > r + 80 && g > b + 50; };
+  // The unit's camera looks along its sweep's centre, so the sail it scanned is in view (a camera turned
+  // away would show none of it): about 2,700 cluster points, 3 px each.
   EXPECT_GT(count(img, kView, green) / area(kView), 0.01);
   EXPECT_GT(count(img, kView, kBlue) / area(kView), 0.002);
   EXPECT_LT(count(img, kView, kRed) / area(kView), 0.002);
@@ -257,6 +259,13 @@ TEST_F(ViewerApp, RefusesBadOptions) {
   const ViewerRun bad_layer = runViewer(*dir_, "--show design,hull --screenshot " + quote(dir_->file("x.png")) + " --frames 2");
   EXPECT_NE(bad_layer.exit_code, 0);
   EXPECT_NE(bad_layer.err.find("unknown layer 'hull'"), std::string::npos) << bad_layer.err;
+  const ViewerRun bad_camera = runViewer(*dir_, "--camera masthead --screenshot " + quote(dir_->file("x.png")) + " --frames 2");
+  EXPECT_NE(bad_camera.exit_code, 0);
+  EXPECT_NE(bad_camera.err.find("--camera"), std::string::npos) << bad_camera.err;
+  const ViewerRun unit_without_units =
+      runViewer(*dir_, quote(dir_->file("sails.sqlite")) + " --camera unit --screenshot " + quote(dir_->file("x.png")) + " --frames 2");
+  EXPECT_NE(unit_without_units.exit_code, 0);
+  EXPECT_NE(unit_without_units.err.find("no scanner unit"), std::string::npos) << unit_without_units.err;
   const ViewerRun live_alone = runViewer(*dir_, "--live 2");
   EXPECT_NE(live_alone.exit_code, 0);
   EXPECT_NE(live_alone.err.find("--screenshot"), std::string::npos) << live_alone.err;
