@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "analysis/errors.hpp"
+#include "database/catalog.hpp"
 #include "database/cloud_blob.hpp"
 #include "database/import.hpp"
 
@@ -28,7 +29,7 @@ SectionParameters readParameters(const Statement& s, int first) {
 ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
   Statement s = db.prepare(
       "SELECT s.id, s.trim_step_id, s.scanned_at, s.cloud, c.name, t.test, t.step_order, t.awa_deg, sa.name,"
-      " sa.design_mesh IS NOT NULL, (SELECT max(a.id) FROM analyses a WHERE a.scan_id = s.id)"
+      " sa.design_mesh IS NOT NULL, (SELECT max(a.id) FROM analyses a WHERE a.scan_id = s.id), s.settings"
       " FROM scans s LEFT JOIN trim_steps t ON t.id = s.trim_step_id LEFT JOIN sessions se ON se.id = t.session_id"
       " LEFT JOIN campaigns c ON c.id = se.campaign_id LEFT JOIN sails sa ON sa.id = t.sail_id WHERE s.id = ?");
   s.bind(1, scan_id);
@@ -45,6 +46,11 @@ ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
   r.sail = s.isNull(8) ? "" : s.columnText(8);
   r.has_design = !s.isNull(9) && s.columnInt(9) != 0;
   r.analysis_id = s.isNull(10) ? 0 : s.columnInt(10);
+  if (!s.isNull(11)) r.settings = nlohmann::json::parse(s.columnText(11), nullptr, false);
+  if (r.settings.is_discarded()) r.settings = nullptr;
+  Statement g = db.prepare("SELECT id FROM registrations WHERE scan_id = ? LIMIT 1");
+  g.bind(1, scan_id);
+  if (g.step()) r.registration = scanTransform(db, scan_id);
   if (r.analysis_id == 0) return r;
 
   Statement a = db.prepare("SELECT params FROM analyses WHERE id = ?");

@@ -27,6 +27,8 @@ struct ScanRecord {
   // (not measurable) is NaN.
   SectionAnalysis sections;
   nlohmann::json analysis_params;  // the pipeline parameters it ran with (null when unknown)
+  nlohmann::json settings;         // the acquisition settings stored with the scan (null when none)
+  std::optional<Eigen::Matrix4d> registration;  // the latest scanner-to-boat transform, when registered
 };
 
 // Throws InvalidInput when there is no scan `scan_id`, DatabaseError for a damaged cloud blob.

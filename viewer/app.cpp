@@ -435,11 +435,18 @@ void App::drawToolbar(float x, float y, float w, float h) {
       if (ImGui::Button(label)) view_.camera = preset;
     }
     ImGui::SameLine();
-    ImGui::BeginDisabled(scanner_.session.units().empty());
-    if (ImGui::Button("Unit")) view_.placement = unitCamera(scanner_.session.units().front().config);
+    // A stored scan shown is seen from the unit that took it; otherwise from the Scanners tab's first unit.
+    const std::optional<UnitConfig> scan_unit =
+        load_.scene && !live_.shown_sweep ? scanUnit(load_.scene->record) : std::nullopt;
+    ImGui::BeginDisabled(!scan_unit && scanner_.session.units().empty());
+    if (ImGui::Button("Unit"))
+      view_.placement = unitCamera(scan_unit ? *scan_unit : scanner_.session.units().front().config);
     ImGui::EndDisabled();
     if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
-      ImGui::SetTooltip("from the first scanner unit (Scanners tab): at its scanner, looking along its sweep's centre");
+      ImGui::SetTooltip(scan_unit ? "from the unit that took this scan (its stored unit settings and registration), "
+                                    "looking along its sweep's centre"
+                                  : "from the first scanner unit (Scanners tab): at its scanner, looking along its "
+                                    "sweep's centre");
     ImGui::SameLine(0, 24);
     // A live sweep that was not stored has no scan to report on.
     ImGui::BeginDisabled(!load_.scene || load_.scene->record.scan_id == 0 || report_.task.busy());

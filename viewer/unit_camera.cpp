@@ -26,4 +26,22 @@ CameraPlacement unitCamera(const UnitConfig& unit, double distance_m) {
   return c;
 }
 
+std::optional<UnitConfig> scanUnit(const ScanRecord& record) {
+  const nlohmann::json& settings = record.settings;
+  if (!settings.is_object() || !settings.contains("pose") || !settings.contains("output_start_deg")) return std::nullopt;
+  // The unit file's own keys, as unitToJson writes them; the scan's other settings (sweep, forces) are not the unit's.
+  const nlohmann::json keys = nlohmann::json::parse(unitToJson(UnitConfig{}));
+  nlohmann::json unit = nlohmann::json::object();
+  for (const auto& item : settings.items())
+    if (keys.contains(item.key())) unit[item.key()] = item.value();
+  UnitConfig u;
+  try {
+    u = parseUnitJson(unit.dump(), "scan " + std::to_string(record.scan_id) + " settings");
+  } catch (const std::exception&) {
+    return std::nullopt;  // settings that do not make a valid unit: no camera from them
+  }
+  if (record.registration) u.pose = Eigen::Isometry3d(*record.registration);
+  return u;
+}
+
 }  // namespace sailshape::viewer

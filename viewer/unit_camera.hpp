@@ -1,7 +1,10 @@
 #pragma once
 // The camera preset "from a scanner unit": the eye at the unit's scanner, looking
 // along the centre of its sweep, as the unit itself sees the sail.
+#include <optional>
+
 #include "acquisition/unit_config.hpp"
+#include "database/scan_record.hpp"
 
 namespace sailshape::viewer {
 
@@ -17,5 +20,11 @@ struct CameraPlacement {
 // View up is the boat's +Z made perpendicular (the shaft's direction when the
 // beam looks straight up or down). Throws InvalidInput for distance_m <= 0.
 CameraPlacement unitCamera(const UnitConfig& unit, double distance_m = 8.0);
+
+// The unit that took a stored scan: its unit file's keys kept in the scan's settings
+// (as `sailshape demo` and `scan` store them; other keys there are ignored), the pose
+// replaced by the scan's registration when it has one (the registration maps the
+// unit's frame into the boat frame). nullopt when the settings hold no unit.
+std::optional<UnitConfig> scanUnit(const ScanRecord& record);
 
 }  // namespace sailshape::viewer

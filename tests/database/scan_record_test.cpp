@@ -30,11 +30,20 @@ TEST(ScanRecord, ReadsBackWhatImportStored) {
   meta.test = "upwind";
   meta.trim_step = 4;
   meta.awa_deg = 31.5;
+  meta.settings = {{"frequency_hz", 25}};
   const Cloud cloud = lineCloud(500);
   const auto doc = analysisDoc(10.0);
   const ImportResult imported = importScan(db, meta, &doc, &cloud);
 
-  const ScanRecord r = loadScanRecord(db, imported.scan_id);
+  ScanRecord r = loadScanRecord(db, imported.scan_id);
+  EXPECT_EQ(r.settings.value("frequency_hz", 0), 25);
+  EXPECT_FALSE(r.registration.has_value());
+  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
+  transform.block<3, 1>(0, 3) = Vec3(1.5, -2.0, 0.25);
+  addRegistration(db, imported.scan_id, transform, 0.004, 0.004);
+  r = loadScanRecord(db, imported.scan_id);
+  ASSERT_TRUE(r.registration.has_value());
+  EXPECT_DOUBLE_EQ((*r.registration)(1, 3), -2.0);
   EXPECT_EQ(r.scan_id, imported.scan_id);
   EXPECT_EQ(r.analysis_id, imported.analysis_id);
   EXPECT_EQ(r.campaign, "Lorient");

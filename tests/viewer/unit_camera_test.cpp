@@ -64,6 +64,41 @@ TEST(UnitCamera, LookingAlongTheShaftStillHasAnUp) {
   EXPECT_NEAR(c.view_up.z(), 0.0, 1e-12);
 }
 
+TEST(UnitCamera, AStoredScanIsSeenFromItsUnitAndRegistration) {
+  // As `sailshape demo` stores a scan: the unit file's keys plus the sweep's own, the cloud in the unit's frame.
+  UnitConfig u = deckUnit(Vec3(1.5, -6.0, 1.2));
+  u.name = "main-unit";
+  ScanRecord record;
+  record.scan_id = 7;
+  record.settings = nlohmann::json::parse(unitToJson(u));
+  record.settings["sweep"] = {{"scans", 120}, {"partial", false}};
+  record.settings["forces"] = "simulated";
+  const std::optional<UnitConfig> from_file = scanUnit(record);
+  ASSERT_TRUE(from_file.has_value());
+  EXPECT_EQ(from_file->name, "main-unit");
+  expectNear(unitCamera(*from_file).position, Vec3(1.5, -6.0, 1.2), 1e-9);  // the unit file's pose
+
+  // The registration (unit frame → boat frame) wins over the nominal pose: here a unit standing 2 m further
+  // aft and 0.5 m higher than its file says, shaft still vertical.
+  Eigen::Isometry3d registered = u.pose;
+  registered.translation() += Vec3(-2.0, 0.0, 0.5);
+  record.registration = registered.matrix();
+  const std::optional<UnitConfig> from_registration = scanUnit(record);
+  ASSERT_TRUE(from_registration.has_value());
+  const CameraPlacement c = unitCamera(*from_registration, 4.0), nominal = unitCamera(*from_file, 4.0);
+  expectNear(c.position, Vec3(-0.5, -6.0, 1.7), 1e-9);
+  expectNear(c.focal_point - c.position, nominal.focal_point - nominal.position, 1e-9);
+
+  // A scan taken in the viewer stores its sweeps, not a unit file: no camera from it.
+  ScanRecord viewer_scan;
+  viewer_scan.settings = {{"sweeps", nlohmann::json::array()}, {"start_spread_s", 0.0}};
+  EXPECT_FALSE(scanUnit(viewer_scan).has_value());
+  EXPECT_FALSE(scanUnit(ScanRecord{}).has_value());
+  ScanRecord broken = record;
+  broken.settings["output_start_deg"] = "wide";
+  EXPECT_FALSE(scanUnit(broken).has_value()) << "settings that make no valid unit give no camera";
+}
+
 TEST(UnitCamera, RefusesANonPositiveDistance) {
   EXPECT_THROW(unitCamera(deckUnit(), 0.0), InvalidInput);
   EXPECT_THROW(unitCamera(deckUnit(), -1.0), InvalidInput);
