@@ -195,7 +195,9 @@ TEST_F(ViewerApp, LiveModeShowsEachAnalysedSweepAndStoresIt) {
   EXPECT_EQ(analysed, 2);
   EXPECT_EQ(swept, analysed + failed);
   // A failed analysis is reported (on stderr as in the panel), never as a crash.
-  if (failed == 0) EXPECT_EQ(r.err, "");
+  if (failed == 0) {
+    EXPECT_EQ(r.err, "");
+  }
 
   const Image img = load(png);
   ASSERT_TRUE(img.rgb);
