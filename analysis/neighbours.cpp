@@ -146,6 +146,30 @@ struct PointGrid::Impl {
       cell_of[i] = slot_cell[s];
       ++count[slot_cell[s]];
     }
+    // Cells in Morton (Z-curve) order of their coordinates: cells near in space
+    // are near in memory, so the 27 cells around a query and the next cell's
+    // neighbours mostly come from cache (first-seen order follows the input's,
+    // which can be random).
+    const size_t cells = count.size();
+    std::vector<uint64_t> code(cells);
+    for (size_t c = 0; c < cells; ++c)
+      code[c] = spread(cell_coord[c].x()) | (spread(cell_coord[c].y()) << 1) | (spread(cell_coord[c].z()) << 2);
+    std::vector<uint32_t> by_code(cells);
+    for (uint32_t c = 0; c < cells; ++c) by_code[c] = c;
+    std::sort(by_code.begin(), by_code.end(), [&](uint32_t a, uint32_t b) { return code[a] < code[b]; });
+    std::vector<uint32_t> rank(cells);
+    for (uint32_t r = 0; r < cells; ++r) rank[by_code[r]] = r;
+    for (size_t s = 0; s < slot_key.size(); ++s)
+      if (slot_key[s] != kEmptySlot) slot_cell[s] = rank[slot_cell[s]];
+    for (uint32_t& c : cell_of) c = rank[c];
+    std::vector<uint32_t> count_sorted(cells);
+    std::vector<Eigen::Vector3i> coord_sorted(cells);
+    for (size_t c = 0; c < cells; ++c) {
+      count_sorted[rank[c]] = count[c];
+      coord_sorted[rank[c]] = cell_coord[c];
+    }
+    count.swap(count_sorted);
+    cell_coord.swap(coord_sorted);
     cell_start.assign(count.size() + 1, 0);
     for (size_t c = 0; c < count.size(); ++c) cell_start[c + 1] = cell_start[c] + count[c];
     sorted.resize(pts.size());
@@ -165,6 +189,16 @@ struct PointGrid::Impl {
       c[a] = static_cast<int>(std::max(-1e9, std::min(1e9, v)));
     }
     return c;
+  }
+  // The 21 low bits of v spread to every third bit.
+  static uint64_t spread(int v) {
+    uint64_t x = static_cast<uint64_t>(v) & 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffull;
+    x = (x | x << 16) & 0x1f0000ff0000ffull;
+    x = (x | x << 8) & 0x100f00f00f00f00full;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
   }
   static uint64_t pack(const Eigen::Vector3i& c) {
     return static_cast<uint64_t>(c.x()) | (static_cast<uint64_t>(c.y()) << kCoordBits) |
@@ -380,7 +414,7 @@ std::unique_ptr<PointGrid> gridForNeighbours(const std::vector<Vec3>& points, si
   auto grid = std::make_unique<PointGrid>(points, guess);
   const double median = medianNeighbourDistance(*grid, points, std::min(k, points.size()), 64);
   const double cell = 1.5 * median;
-  if (cell > 0 && (cell < 0.7 * grid->cellSize() || cell > 1.4 * grid->cellSize()))
+  if (cell > 0 && (cell < 0.85 * grid->cellSize() || cell > 1.2 * grid->cellSize()))
     grid = std::make_unique<PointGrid>(points, cell);
   return grid;
 }

@@ -280,14 +280,15 @@ TEST(PointGrid, TableMatchesTheKdTreeOnANoisySheet) {
 }
 
 TEST(PointGrid, GridForNeighboursSizesCellsByTheKthNeighbourDistance) {
-  // Uniform points at ρ per m²: the k-th neighbour lies near sqrt(k / (π ρ)); the cell
-  // is 1.5 × the sampled median of it (64 samples and edge effects: ±15 %).
+  // Uniform points at ρ per m²: the k-th point (itself first) is the (k-1)-th other one,
+  // so π ρ r² follows Gamma(k - 1, 1), whose median is about k - 4/3; the cell is 1.5 ×
+  // the sampled median distance (64 samples and edge effects: ±15 %).
   std::mt19937 rng(25);
   std::uniform_real_distribution<double> U(0.0, 2.0);
   std::vector<Vec3> pts(40000);
   for (Vec3& p : pts) p = Vec3(U(rng), U(rng), 0.0);
   for (size_t k : {size_t{5}, size_t{30}, size_t{200}}) {
-    const double expected = 1.5 * std::sqrt(static_cast<double>(k) / (M_PI * 10000.0));
+    const double expected = 1.5 * std::sqrt((static_cast<double>(k) - 4.0 / 3.0) / (M_PI * 10000.0));
     EXPECT_NEAR(gridForNeighbours(pts, k)->cellSize(), expected, 0.15 * expected) << "k " << k;
   }
 }
