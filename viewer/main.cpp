@@ -306,7 +306,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   cli.add_option("--live", o.live,
                  "with --screenshot: add an emulated deck unit and run live mode (every sweep stored in the open "
-                 "database) until N sweeps are analysed, then count frames")
+                 "database) until N sweeps are analysed (a sweep already taken then is analysed too), then count frames")
       ->check(CLI::Range(1, 20));
   cli.add_option("--camera", o.camera,
                  "with --screenshot: once loaded, view from this preset: 3/4, side, top, astern, bow, or unit (from "

@@ -192,7 +192,7 @@ TEST_F(ViewerApp, LiveModeShowsEachAnalysedSweepAndStoresIt) {
   const auto at = r.out.find("live: ");
   ASSERT_NE(at, std::string::npos) << r.out;
   ASSERT_EQ(std::sscanf(r.out.c_str() + at, "live: %d swept, %d analysed, %d failed", &swept, &analysed, &failed), 3) << r.out;
-  EXPECT_EQ(analysed, 2);
+  EXPECT_GE(analysed, 2) << "a sweep already taken when live mode stops is analysed too";
   EXPECT_EQ(swept, analysed + failed);
   // A failed analysis is reported (on stderr as in the panel), never as a crash.
   if (failed == 0) {
