@@ -25,6 +25,7 @@
 #include "analysis/registration.hpp"
 #include "analysis/rigid_transform.hpp"
 #include "analysis/sail_generator.hpp"
+#include "analysis/spars.hpp"
 #include "database/catalog.hpp"
 #include "database/import.hpp"
 #include "database/schema.hpp"
@@ -112,14 +113,13 @@ BoatReference tunnelWalls() {
   return ref;
 }
 
-// A spar of the rig in the boat frame: the crew measures these once per boat.
-struct Spar {
-  Vec3 base, axis;  // axis unit
-  double length_m, radius_m;
-};
-// The built-in tunnel model's mast and boom (acquisition/scene.cpp builtInTunnelScene).
-const Spar kTunnelSpars[] = {{Vec3(0.035, 0, 0), Vec3::UnitZ(), 3.05, 0.025},
-                             {Vec3(0.0, 0, 0.26), -Vec3::UnitX(), 1.05, 0.015}};
+// The built-in tunnel model's mast and boom (acquisition/scene.cpp builtInTunnelScene),
+// in the boat frame as the crew measures them once per boat.
+std::vector<Spar> tunnelSpars() {
+  Spar mast{"mast", Vec3(0.035, 0, 0), Vec3::UnitZ(), 3.05, 0.025};
+  Spar boom{"boom", Vec3(0.0, 0, 0.26), -Vec3::UnitX(), 1.05, 0.015};
+  return {mast, boom};
+}
 constexpr double kDeckZ = 0.0;
 
 // --- the two units ------------------------------------------------------------------
@@ -129,7 +129,7 @@ struct RigUnit {
   Eigen::Isometry3d true_pose;     // where the emulated unit really stands (placement error)
   std::string sail;                // the sail it scans
   std::string sail_file;           // its name in file names
-  double roi_max_x_m = 1e9;        // its region of interest ends here (the mast, for a mainsail)
+  bool roi_ends_at_mast = false;   // a mainsail's region of interest ends at the mast's axis
   SailDesign design;
   Mesh design_mesh;
   MeshSections design_sections;
@@ -168,7 +168,7 @@ std::vector<RigUnit> makeRig(const DemoOptions& o, const SectionParams& sections
   rig[0].sail = "Demo 36 main";
   rig[0].sail_file = "main";
   rig[0].design = mainDesign();
-  rig[0].roi_max_x_m = kTunnelSpars[0].base.x();
+  rig[0].roi_ends_at_mast = true;
   // Gennaker unit: forward on the port side, looking back at the A2's leeward face, an LMS111.
   rig[1].config.name = "tunnel-gennaker-lms111";
   rig[1].config.model = ScannerModel::Lms111;
@@ -232,13 +232,14 @@ struct EmulatedUnit {
 // from the sail where the luff and foot touch them at model scale, and forward of
 // `max_x_m` (a mainsail's box ends at the mast: beyond it lie the mast's mixed
 // pixels and the headsail).
-Cloud cropToSail(const Cloud& cloud, const Mesh& design, double margin_m, double clearance_m, double max_x_m) {
+Cloud cropToSail(const Cloud& cloud, const Mesh& design, double margin_m, double clearance_m, double max_x_m,
+                 const std::vector<Spar>& spars) {
   Eigen::AlignedBox3d box;
   for (const Vec3& v : design.vertices) box.extend(v);
   box.min().array() -= margin_m;
   box.max().array() += margin_m;
   auto nearSpar = [&](const Vec3& p) {
-    for (const Spar& s : kTunnelSpars) {
+    for (const Spar& s : spars) {
       const double along = (p - s.base).dot(s.axis);
       if (along < -clearance_m || along > s.length_m + clearance_m) continue;
       if ((p - s.base - along * s.axis).norm() < s.radius_m + clearance_m) return true;
@@ -423,7 +424,22 @@ DemoResult runDemo(const DemoOptions& o, const DemoLog& log_fn, const Progress& 
         ap.sections = sp;
         ap.outline.design_lengths_m = {u.design_sections.outline.luff_length_m, u.design_sections.outline.leech_length_m,
                                        u.design_sections.outline.foot_length_m};
-        const Cloud roi = cropToSail(boat_clouds[i], u.design_mesh, 0.1, 3 * ap.sensor_sigma_m, u.roi_max_x_m);
+        // The spars where this cloud has them: the registration is good to a couple of
+        // centimetres, as much as the gap between the mast and the luff.
+        std::vector<Spar> spars;
+        for (const Spar& nominal : tunnelSpars()) {
+          SparFitParams fp;
+          fp.sensor_sigma_m = ap.sensor_sigma_m;
+          const SparFit f = fitSpar(boat_clouds[i], nominal, fp);
+          if (f.found)
+            log(tag + ": " + u.config.name + ": " + nominal.name + " found " +
+                std::to_string(static_cast<int>(std::lround(1000 * f.offset.norm()))) + " mm from its measured place");
+          else
+            log(tag + ": " + u.config.name + ": " + nominal.name + " not in view; its measured place is used");
+          spars.push_back(f.spar);
+        }
+        const double max_x = u.roi_ends_at_mast ? spars.front().base.x() : 1e9;
+        const Cloud roi = cropToSail(boat_clouds[i], u.design_mesh, 0.1, 3 * ap.sensor_sigma_m, max_x, spars);
         writeCloud(cloud_dir + "/step" + std::to_string(step + 1) + "-" + u.sail_file + "-roi.ply", roi);
         try {
           analyses[i] = analyzeSail(roi, ap, progress);
