@@ -279,7 +279,7 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
         inside[a] = surfaces[a].centroid_offset <= kInsideCentroidOffset && anchor_radius[a] <= kInsideRadius * radius;
       std::vector<Vec3> anchor_pts(anchors.size());
       for (size_t a = 0; a < anchors.size(); ++a) anchor_pts[a] = pts[anchors[a]];
-      const PointGrid anchor_grid(anchor_pts, std::max(1e-6, 2 * p.anchor_ratio * radius));
+      const PointGrid anchor_grid(anchor_pts, std::max(1e-6, p.anchor_ratio * radius));
       const size_t blend = std::min<size_t>(4, anchors.size());
       std::vector<char> own_fit(pts.size(), 0);
 #pragma omp parallel
