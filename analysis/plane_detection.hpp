@@ -2,7 +2,9 @@
 // Planar regions of a scene (tunnel walls, floor, ceiling, deck, the faces of a
 // reference cube), for the plane-based registration of SPEC §4 step 2: region
 // growing on normals and curvature proposes regions, a RANSAC plane test keeps
-// the flat ones, a least-squares fit on the inliers gives each plane's pose.
+// the flat ones and peels further planes off regions that hold several and
+// off the points no region took, a least-squares fit on the inliers gives
+// each plane's pose.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,6 +33,16 @@ struct PlaneDetectionParams {
   int ransac_iterations = 100;
   double min_inlier_fraction = 0.85;  // of a region's points within the threshold of its RANSAC plane
   double max_rms_m = 0.008;           // a plane's inliers lie within ~2σ RMS of it
+  // A region that is not one plane (two faces of a cube joined over their
+  // edge), and the connected points no region took (a face seen head-on at a
+  // density where the noise exceeds the curvature limit), are split: the
+  // dominant plane is peeled off and each connected rest of at least
+  // region.min_points tried again. Such a piece must lie as close to its
+  // plane as the sensor allows (SPEC §3, σ = 4 mm): within σ + 25 % RMS.
+  double max_piece_rms_m = 0.005;
+  // No plane may bow from flat by more than σ/2 RMS (a quadric fitted to its
+  // points' distances, noise aside): a patch or band of a curved sail does.
+  double max_bow_m = 0.002;
   double min_extent_m = 0.25;         // both in-plane spreads at least this
   // Regions of one physical plane split by an occlusion are merged when their
   // normals are within this angle and their offsets within this distance.
@@ -43,6 +55,7 @@ struct PlaneDetectionParams {
 struct PlaneDetection {
   std::vector<DetectedPlane> planes;  // largest (most inliers) first
   size_t regions = 0;                 // regions region growing proposed
+  size_t split_planes = 0;            // planes peeled from regions that were not one plane
   std::vector<std::string> warnings;  // e.g. regions rejected as not flat
 };
 
