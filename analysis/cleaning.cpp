@@ -1,6 +1,9 @@
 #include "analysis/cleaning.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <Eigen/Eigenvalues>
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
@@ -68,6 +71,67 @@ Cleaning removeRadiusOutliers(const Cloud& cloud, const RadiusOutlierParams& p, 
   for (size_t i = 0; i < cloud.size(); ++i)
     (table.rowDist2(i)[need - 1] <= r2 ? result.kept : result.removed).push_back(static_cast<uint32_t>(i));
   progress("outliers", 1.0);
+  return result;
+}
+
+Cleaning readmitSurfacePoints(const Cloud& cloud, const std::vector<uint32_t>& kept, const ReadmitParams& p) {
+  if (p.k_neighbours < 3)
+    throw InvalidInput("[readmitSurfacePoints] k_neighbours must be >= 3 (got " + std::to_string(p.k_neighbours) + ")");
+  if (!(p.max_offset_m > 0) || !(p.max_gap_factor > 0))
+    throw InvalidInput("[readmitSurfacePoints] max_offset_m and max_gap_factor must be > 0");
+  std::vector<char> in(cloud.size(), 0);
+  for (uint32_t i : kept) {
+    if (i >= cloud.size())
+      throw InvalidInput("[readmitSurfacePoints] kept index " + std::to_string(i) + " outside the cloud of " +
+                         std::to_string(cloud.size()) + " points");
+    in[i] = 1;
+  }
+  const size_t k = static_cast<size_t>(p.k_neighbours);
+  Cleaning result;
+  if (kept.size() > k) {
+    std::vector<Vec3> pts;
+    for (uint32_t i : kept) pts.push_back(cloud.points[i]);
+    double spacing = 0;
+    {
+      const KdTree tree(pts);
+      spacing = medianNeighbourDistance(tree, pts, 2);
+    }
+    const double max_gap = p.max_gap_factor * spacing;
+    std::vector<uint32_t> idx;
+    std::vector<double> d2;
+    // Removed points within reach of the current members and on their surface.
+    auto collect = [&] {
+      std::vector<uint32_t> back;
+      const KdTree tree(pts);  // holds `pts` by reference
+      for (uint32_t i = 0; i < cloud.size(); ++i) {
+        if (in[i]) continue;
+        const Vec3& q = cloud.points[i];
+        tree.nearest(q, k, idx, d2);
+        if (idx.size() < 3 || std::sqrt(d2.front()) > max_gap) continue;
+        Vec3 centre = Vec3::Zero();
+        for (uint32_t j : idx) centre += pts[j];
+        centre /= static_cast<double>(idx.size());
+        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+        for (uint32_t j : idx) cov += (pts[j] - centre) * (pts[j] - centre).transpose();
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+        // Neighbours along a line give no plane to test against.
+        if (eig.eigenvalues()(1) < 1e-6 * eig.eigenvalues()(2)) continue;
+        if (std::abs((q - centre).dot(eig.eigenvectors().col(0))) <= p.max_offset_m) back.push_back(i);
+      }
+      return back;
+    };
+    for (int pass = 0; pass < p.passes; ++pass) {
+      const std::vector<uint32_t> back = collect();
+      if (back.empty()) break;
+      // Admitted after the pass, so the result does not depend on the visiting order.
+      for (uint32_t i : back) {
+        in[i] = 1;
+        pts.push_back(cloud.points[i]);
+      }
+    }
+  }
+  for (uint32_t i = 0; i < cloud.size(); ++i) (in[i] ? result.kept : result.removed).push_back(i);
+  result.threshold_m = p.max_offset_m;
   return result;
 }
 

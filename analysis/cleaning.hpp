@@ -34,4 +34,20 @@ struct RadiusOutlierParams {
 Cleaning removeRadiusOutliers(const Cloud& cloud, const RadiusOutlierParams& params = {},
                               const Progress& progress = {});
 
+// Points the outlier filters removed only for being sparse (the narrow tip of a
+// head, a far and thinly sampled edge) still lie on the surface the kept points
+// describe. A removed point is readmitted when its nearest kept point is within
+// max_gap_factor × the kept points' median spacing and it lies within
+// max_offset_m of the plane through its k nearest kept points; `passes` rounds,
+// so a chain of tip points comes back one by one. Points off the surface
+// (mixed pixels, spray, rigging) stay out.
+struct ReadmitParams {
+  int k_neighbours = 12;
+  double max_offset_m = 0.0;     // must be > 0 here; in AnalysisParams 0 means 3 × sensor σ
+  double max_gap_factor = 6.0;
+  int passes = 4;
+};
+// `kept` indexes `cloud` (ascending); the result's kept/removed index `cloud` too.
+Cleaning readmitSurfacePoints(const Cloud& cloud, const std::vector<uint32_t>& kept, const ReadmitParams& params = {});
+
 }  // namespace sailshape

@@ -17,6 +17,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SailPickParams, method, seed_poi
                                                 min_depth_ratio, min_extent_m, max_tilt_deg)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StatisticalOutlierParams, k_neighbours, std_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RadiusOutlierParams, radius_m, min_neighbours)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ReadmitParams, k_neighbours, max_offset_m, max_gap_factor, passes)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SmoothingParams, k_neighbours, polynomial_order, anchor_ratio, good_m,
                                                 fair_m)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SurfaceParams, projection, max_edge_m, max_edge_factor,
@@ -29,7 +30,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions,
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, normals, segment,
                                                 segmentation_voxel_sigmas, region_growing,
                                                 sail_pick, statistical_outliers, statistical, radius_outliers, radius,
-                                                smooth, smoothing, surface, outline, sections)
+                                                readmit_surface_points, readmit, smooth, smoothing, surface, outline, sections)
 
 namespace {
 

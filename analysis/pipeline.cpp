@@ -1,5 +1,6 @@
 #include "analysis/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
@@ -102,16 +103,37 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), w);
   }
 
+  // Cleaning keeps indices into the segmented cloud, so that the points the
+  // filters removed only for being sparse can come back afterwards.
+  const Cloud segmented = cloud;
+  std::vector<uint32_t> kept(segmented.size());
+  for (uint32_t i = 0; i < kept.size(); ++i) kept[i] = i;
+  auto keepOnly = [&](const std::vector<uint32_t>& local) {
+    std::vector<uint32_t> next;
+    next.reserve(local.size());
+    for (uint32_t j : local) next.push_back(kept[j]);
+    kept = std::move(next);
+    cloud = selectPoints(segmented, kept);
+  };
   if (p.statistical_outliers) {
     StageTimer t(a, "statistical outliers", cloud.size());
     const Cleaning c = removeStatisticalOutliers(cloud, p.statistical, progress);
-    cloud = selectPoints(cloud, c.kept);
+    keepOnly(c.kept);
     t.finish(cloud.size(), c.warnings);
   }
   if (p.radius_outliers) {
     StageTimer t(a, "radius outliers", cloud.size());
     const Cleaning c = removeRadiusOutliers(cloud, p.radius, progress);
-    cloud = selectPoints(cloud, c.kept);
+    keepOnly(c.kept);
+    t.finish(cloud.size(), c.warnings);
+  }
+  if ((p.statistical_outliers || p.radius_outliers) && p.readmit_surface_points && kept.size() < segmented.size()) {
+    StageTimer t(a, "readmit surface points", cloud.size());
+    ReadmitParams rp = p.readmit;
+    if (rp.max_offset_m == 0) rp.max_offset_m = 3.0 * p.sensor_sigma_m;
+    const Cleaning c = readmitSurfacePoints(segmented, kept, rp);
+    kept = c.kept;
+    cloud = selectPoints(segmented, kept);
     t.finish(cloud.size(), c.warnings);
   }
   a.sail_points = cloud.size();

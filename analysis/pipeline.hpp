@@ -32,6 +32,8 @@ struct AnalysisParams {
   StatisticalOutlierParams statistical;
   bool radius_outliers = true;
   RadiusOutlierParams radius;
+  bool readmit_surface_points = true;  // give back removed points that lie on the surface
+  ReadmitParams readmit;
   bool smooth = true;
   SmoothingParams smoothing;
   SurfaceParams surface;

@@ -162,6 +162,7 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
     for (size_t i = 0; i < e.points.size(); ++i) inner.push_back(i);
     e.exclude = 0;
   }
+
   const int degree = static_cast<int>(std::clamp<size_t>(inner.size() / 8, 1, 5));
   auto fit = [&] {
     std::vector<Vec3> pts;
@@ -192,6 +193,8 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
     if (in.dot(centre - c) < 0) in = -in;
     inward[i] = in;
   }
+
+
   const double strip = 4.0 * spacing;
   double sum = 0;
   size_t count = 0;
@@ -200,7 +203,10 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
     const size_t i = inner[k];
     const Vec3 c = e.curve.at(e.s[i]);
     const Vec3 t = e.curve.tangent(e.s[i]);
-    tree.withinRadius(c, strip, idx, d2);
+    // The disc must hold the whole window |along| <= spacing, 0 <= o <= strip: a disc
+    // of radius `strip` alone cuts its far corners, thins the samples near o = strip
+    // and so overstates the recess (by about 0.08 × spacing).
+    tree.withinRadius(c, std::hypot(strip, spacing), idx, d2);
     for (uint32_t v : idx) {
       if (seen[v]) continue;
       const Vec3 d = mesh.vertices[v] - c;
@@ -232,8 +238,14 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
 }
 
 // A quadratic through an edge's points near one of its corners, as a function
-// of the arc distance d from that corner (the rounded-off tip left out).
-EdgeCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree) {
+// of the arc distance d from that corner (the rounded-off tip left out), with
+// the 1σ scatter of its value extrapolated back to the corner.
+struct CornerCurve {
+  EdgeCurve curve;
+  double sigma_at_corner = 0;  // m
+};
+
+CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree) {
   const double skip = 3.0 * spacing, reach = std::max(60.0 * spacing, 0.05 * e.length);
   std::vector<Vec3> pts;
   std::vector<double> d;
@@ -252,13 +264,31 @@ EdgeCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree) 
       d.push_back(at_start ? e.s[i] : e.length - e.s[i]);
     }
   }
-  return fitEdgeCurve(pts, d, pts.size() >= 12 ? degree : 1);
+  CornerCurve c;
+  const int used = pts.size() >= 12 ? degree : 1;
+  c.curve = fitEdgeCurve(pts, d, used);
+  double res2 = 0;
+  for (size_t i = 0; i < pts.size(); ++i) res2 += (pts[i] - c.curve.at(d[i])).squaredNorm();
+  const double n = static_cast<double>(pts.size());
+  const double sigma_res = std::sqrt(res2 / std::max(1.0, n - used - 1));
+  // A least-squares polynomial of degree q over evenly spread points is known at
+  // the end of its range to about σ_res·(q + 1)/√N; the corner lies just beyond.
+  c.sigma_at_corner = sigma_res * (used + 1) / std::sqrt(n);
+  return c;
 }
 
-// Where two edges meet: the closest pair of points of their corner curves
-// (quadratics in the distance from the corner, extrapolated back to it).
-Vec3 meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing) {
-  const EdgeCurve ca = cornerCurve(a, a_start, spacing, 2), cb = cornerCurve(b, b_start, spacing, 2);
+// Where two edges meet, and how they arrive there.
+struct Meeting {
+  Vec3 point = Vec3::Zero();
+  Vec3 outward = Vec3::Zero();  // unit, out of the sail along the corner's bisector
+  double angle_rad = 0;         // interior angle between the two edges
+  double sigma_along_m = 0;     // 1σ of `point` along `outward`
+};
+
+// The closest pair of points of the two edges' corner curves (quadratics in the
+// distance from the corner, extrapolated back to it).
+Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing) {
+  const CornerCurve ca = cornerCurve(a, a_start, spacing, 2), cb = cornerCurve(b, b_start, spacing, 2);
   const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
   double best = std::numeric_limits<double>::infinity(), sa = 0, sb = 0;
   double r = range;
@@ -267,7 +297,7 @@ Vec3 meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double 
     for (int i = -10; i <= 10; ++i)
       for (int j = -10; j <= 10; ++j) {
         const double ta = ma + r * i / 10.0, tb = mb + r * j / 10.0;
-        const double dd = (ca.at(ta) - cb.at(tb)).squaredNorm();
+        const double dd = (ca.curve.at(ta) - cb.curve.at(tb)).squaredNorm();
         if (dd < best) {
           best = dd;
           sa = ta;
@@ -276,7 +306,55 @@ Vec3 meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double 
       }
     r /= 5.0;
   }
-  return 0.5 * (ca.at(sa) + cb.at(sb));
+  Meeting m;
+  m.point = 0.5 * (ca.curve.at(sa) + cb.curve.at(sb));
+  // Directions into the sail along each edge (increasing distance from the corner).
+  const Vec3 ta = ca.curve.tangent(sa), tb = cb.curve.tangent(sb);
+  m.angle_rad = std::acos(std::clamp(ta.dot(tb), -1.0, 1.0));
+  const Vec3 bis = ta + tb;
+  m.outward = bis.norm() > 1e-9 ? Vec3(-bis.normalized()) : Vec3::Zero();
+  // Shifting the two edges sideways by ε_a and ε_b moves their crossing along
+  // the bisector by (ε_a + ε_b) / (2 sin(angle / 2)).
+  const double half = std::max(0.5 * m.angle_rad, 1e-3);
+  // Each edge's sideways uncertainty at the corner: its corner curve's, the whole
+  // edge's, and half its recess: the edge was moved out by its recess averaged
+  // along it, and where the sail narrows to a corner the samples thin out
+  // differently, so how far the edge lies beyond them there is known only roughly.
+  const double side_a = std::hypot(ca.sigma_at_corner, a.sigma, 0.5 * a.recess);
+  const double side_b = std::hypot(cb.sigma_at_corner, b.sigma, 0.5 * b.recess);
+  m.sigma_along_m = std::hypot(side_a, side_b) / (2.0 * std::sin(half));
+  return m;
+}
+
+// At a narrow corner (the head of most sails) the crossing of the two edges is
+// poorly placed along the bisector, while the samples say where the sail at least
+// reaches: the corner lies at or beyond the outermost sample, and a wedge of
+// length L beyond it, sampled at ρ points/m², stays empty with probability
+// exp(−ρ·L²·tan(angle/2)) (the wedge's area). The corner is placed at the mean
+// of the crossing's Gaussian times that probability, for L ≥ 0.
+Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const KdTree& tree, double density, double reach) {
+  if (m.outward.isZero() || !(density > 0) || !(m.sigma_along_m > 0)) return m.point;
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  tree.withinRadius(m.point, reach, idx, d2);
+  if (idx.empty()) return m.point;
+  double extreme = -std::numeric_limits<double>::infinity();
+  for (uint32_t v : idx) extreme = std::max(extreme, (mesh.vertices[v] - m.point).dot(m.outward));
+  const double lambda = density * std::tan(std::min(0.5 * m.angle_rad, 1.4));
+  const double gap_scale = 1.0 / std::sqrt(lambda);  // typical empty tip length, m
+  const double s = m.sigma_along_m;
+  const double lo = extreme, hi = std::max(extreme, 0.0) + 6.0 * std::max(s, gap_scale);
+  constexpr int kSteps = 2000;
+  double wsum = 0, xsum = 0;
+  for (int i = 1; i <= kSteps; ++i) {
+    const double x = lo + (hi - lo) * i / kSteps;  // corner position along the bisector
+    const double gap = x - extreme;
+    const double w = std::exp(-0.5 * (x / s) * (x / s) - lambda * gap * gap);
+    wsum += w;
+    xsum += w * x;
+  }
+  if (!(wsum > 0)) return m.point + std::max(extreme, 0.0) * m.outward;
+  return m.point + (xsum / wsum) * m.outward;
 }
 
 // The edge from corner to corner: the fitted curve between the excluded ends.
@@ -456,13 +534,18 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   Edge top;
   if (out.has_peak) top = makeEdge(head, peak);
   const double sp = out.boundary_spacing_m;
-  out.tack = meetEdges(luff, true, foot, true, sp);
-  out.clew = meetEdges(foot, false, leech, true, sp);
+  const double density = static_cast<double>(mesh.vertices.size()) / std::max(1e-12, meshArea(mesh));
+  const double reach = std::max(0.05 * total, 10.0 * sp);
+  auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start) {
+    return placeCorner(meetEdges(a, a_start, b, b_start, sp), mesh, tree, density, reach);
+  };
+  out.tack = corner(luff, true, foot, true);
+  out.clew = corner(foot, false, leech, true);
   if (out.has_peak) {
-    out.head = meetEdges(luff, false, top, true, sp);
-    out.peak = meetEdges(leech, false, top, false, sp);
+    out.head = corner(luff, false, top, true);
+    out.peak = corner(leech, false, top, false);
   } else {
-    out.head = meetEdges(luff, false, leech, false, sp);
+    out.head = corner(luff, false, leech, false);
   }
   out.luff_sigma_m = luff.sigma;
   out.leech_sigma_m = leech.sigma;

@@ -183,5 +183,87 @@ TEST(RemoveRadiusOutliers, RejectsBadParametersAndTinyClouds) {
   expectInvalidInput([&] { removeRadiusOutliers(Cloud{}, RadiusOutlierParams{}); }, {"[removeRadiusOutliers]"});
 }
 
+// The head of a sail: a 20° wedge 3 m long in the plane z = 0 at 2500 points/m²
+// with σ = 4 mm noise across it, apex at the origin pointing along −y, and
+// points 0.1 m off the plane (spray, rigging) scattered over it.
+struct Wedge {
+  Cloud cloud;
+  std::vector<double> offset;  // each inlier's distance from the plane, in σ (NaN for outliers)
+  std::set<uint32_t> outliers;
+};
+
+Wedge sailHead(uint32_t seed) {
+  Wedge w;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::normal_distribution<double> N(0.0, 1.0);
+  const double half = std::tan(10.0 * 3.14159265358979 / 180.0), length = 3.0;
+  const size_t n = static_cast<size_t>(2500 * length * length * half);  // area = length² · tan(10°)
+  for (size_t i = 0; i < n + 60; ++i) {
+    // Uniform over the triangle: the distance from the apex goes as √U.
+    const double d = length * std::sqrt(U(rng)), x = (2 * U(rng) - 1) * half * d;
+    if (i < n) {
+      const double e = N(rng);
+      w.cloud.points.emplace_back(x, -d, kSigma * e);
+      w.offset.push_back(std::abs(e));
+    } else {
+      w.outliers.insert(static_cast<uint32_t>(w.cloud.size()));
+      w.cloud.points.emplace_back(x, -d, (i % 2 ? 0.1 : -0.1));
+      w.offset.push_back(std::numeric_limits<double>::quiet_NaN());
+    }
+  }
+  return w;
+}
+
+TEST(ReadmitSurfacePoints, BringsBackTheSparseTipTheFiltersCutAndKeepsOutliersOut) {
+  const Wedge w = sailHead(5);
+  // The pipeline's two filters, one after the other, in indices of the input.
+  const Cleaning s = removeStatisticalOutliers(w.cloud);
+  const Cloud after_s = selectPoints(w.cloud, s.kept);
+  const Cleaning r = removeRadiusOutliers(after_s);
+  std::vector<uint32_t> kept;
+  for (uint32_t j : r.kept) kept.push_back(s.kept[j]);
+  std::set<uint32_t> filtered(kept.begin(), kept.end());
+  size_t tip_lost = 0;
+  for (uint32_t i = 0; i < w.cloud.size(); ++i)
+    if (!w.outliers.count(i) && !filtered.count(i) && -w.cloud.points[i].y() < 0.3) ++tip_lost;
+  ASSERT_GT(tip_lost, 0u) << "the filters must have cut into the tip for this test to say anything";
+
+  ReadmitParams p;
+  p.max_offset_m = 3 * kSigma;
+  const Cleaning c = readmitSurfacePoints(w.cloud, kept, p);
+  ASSERT_EQ(c.kept.size() + c.removed.size(), w.cloud.size());
+  EXPECT_TRUE(std::is_sorted(c.kept.begin(), c.kept.end()));
+  const std::set<uint32_t> back(c.kept.begin(), c.kept.end());
+  for (uint32_t i : kept) EXPECT_TRUE(back.count(i)) << "a point the filters kept stays";
+  for (uint32_t i : w.outliers) EXPECT_FALSE(back.count(i)) << "outlier " << i << " 0.1 m off the surface came back";
+  // Every inlier within 2σ of the plane is on the surface by any account: all of
+  // them are back, the tip's included (the plane through 12 neighbours is itself
+  // known to about σ/√12, so the 3σ limit leaves them a clear margin).
+  for (uint32_t i = 0; i < w.cloud.size(); ++i)
+    if (!w.outliers.count(i) && w.offset[i] <= 2.0)
+      EXPECT_TRUE(back.count(i)) << "inlier " << i << " at " << -w.cloud.points[i].y() << " m from the apex";
+}
+
+TEST(ReadmitSurfacePoints, RejectsBadParametersAndIndices) {
+  const Wedge w = sailHead(1);
+  std::vector<uint32_t> kept(w.cloud.size() / 2);
+  for (uint32_t i = 0; i < kept.size(); ++i) kept[i] = i;
+  ReadmitParams p;
+  p.max_offset_m = 0.012;
+  ReadmitParams bad = p;
+  bad.k_neighbours = 2;
+  EXPECT_THROW(readmitSurfacePoints(w.cloud, kept, bad), InvalidInput);
+  bad = p;
+  bad.max_offset_m = 0;
+  EXPECT_THROW(readmitSurfacePoints(w.cloud, kept, bad), InvalidInput);
+  bad = p;
+  bad.max_gap_factor = -1;
+  EXPECT_THROW(readmitSurfacePoints(w.cloud, kept, bad), InvalidInput);
+  std::vector<uint32_t> outside = kept;
+  outside.push_back(static_cast<uint32_t>(w.cloud.size()));
+  EXPECT_THROW(readmitSurfacePoints(w.cloud, outside, p), InvalidInput);
+}
+
 }  // namespace
 }  // namespace sailshape

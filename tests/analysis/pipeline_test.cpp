@@ -76,17 +76,22 @@ TEST(Pipeline, CleanJibRecoversKnownSections) {
 }
 
 TEST(Pipeline, CleanGennakerRecoversKnownSectionsAndLuffCurve) {
-  // 100,000 points on the 44 m² gennaker: the mainsail's point density.
+  // 400,000 points on the 44 m² gennaker. At the mainsail test's density
+  // (100,000 here) its long curved edges are placed to about ±3 mm, which at the
+  // 1.8 m chord of the top section is ±0.1° of twist, the target itself (the
+  // analysis reports that uncertainty, and the error lands either side of 0.1°
+  // from seed to seed); four times the points resolve the target.
   const SailDesign design = exampleDesign(SailType::Gennaker);
   ScanSimulation sim;
-  sim.points = 100000;
+  sim.points = 400000;
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   const SailSurface truth(design);
   expectSectionsMatch(a, truth, kClean);
   EXPECT_LT((a.outline.tack - truth.tack()).norm(), kClean.corner_m);
   EXPECT_LT((a.outline.clew - truth.clew()).norm(), kClean.corner_m);
-  // The head, where the curved luff meets the leech at a narrow angle, is 4 cm
-  // off on this seed (1–4 cm over seeds): not yet within the 3 cm target.
+  // The head, where the curved luff meets the leech at a narrow angle: the edges'
+  // crossing is weighed against how far the samples reach (sail_outline.cpp).
+  EXPECT_LT((a.outline.head - truth.head()).norm(), kClean.corner_m);
   // The luff curve measured on the design's own luff, corners and clew.
   SailOutline design_outline;
   design_outline.tack = truth.tack();
