@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -52,8 +53,12 @@ PrivateDisplay::PrivateDisplay(int timeout_ms) {
   // Display numbers are taken explicitly: Xvfb then holds /tmp/.X<n>-lock and
   // exits at once when another server has it. (-displayfd without a number
   // lets two servers starting together both claim the same display.) The
-  // first number depends on the process id, so concurrent reports rarely collide.
-  const int first = 200 + static_cast<int>(getpid() % 500);
+  // first number depends on the process id, so concurrent reports rarely collide,
+  // and moves on with every server this process starts: a later report never
+  // reuses the name of a server an earlier one stopped (Mesa's GLX keeps state per
+  // display name, and a reused name intermittently met "bad X server connection").
+  static std::atomic<int> started_before{0};
+  const int first = 200 + static_cast<int>(getpid() % 500) + 40 * started_before++;
   std::string last_error;
   for (int attempt = 0; attempt < 40 && pid_ <= 0; ++attempt) {
     const int n = first + attempt;
@@ -116,6 +121,9 @@ bool PrivateDisplay::startXvfb(const std::string& xvfb, const std::string& numbe
     }
   }
   close(fds[0]);
+  // Ready on the pipe should mean it accepts clients; make sure before VTK, which
+  // aborts the process on a display it cannot open, gets to it.
+  if (done && !reported.empty() && !displayOpens(":" + reported)) done = false;
   if (!done || reported.empty()) {
     kill(pid, SIGTERM);
     waitpid(pid, nullptr, 0);
