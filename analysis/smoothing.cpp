@@ -191,8 +191,7 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
   result.displacement_m.resize(cloud.size());
 
   {
-    // The neighbourhood radius, from a sample of points; neighbourhoods from a
-    // grid of cells one radius wide.
+    // The neighbourhood radius: the median k-th neighbour distance over a sample of points.
     const double radius = std::max(1e-6, medianNeighbourDistance(*gridForNeighbours(pts, k), pts, k, 256));
     // Gathered from a grid a little wider than the radius, so the k nearest of
     // most points whose radius holds fewer than k are among the candidates too.
