@@ -6,21 +6,52 @@
 #include <Eigen/Eigenvalues>
 
 #include "analysis/errors.hpp"
-#include "analysis/neighbours.hpp"
 
 namespace sailshape {
 
-Cleaning removeStatisticalOutliers(const Cloud& cloud, const StatisticalOutlierParams& p, const Progress& progress) {
+namespace {
+
+void checkStatistical(const Cloud& cloud, const StatisticalOutlierParams& p) {
   if (p.k_neighbours < 1)
     throw InvalidInput("[removeStatisticalOutliers] k_neighbours must be >= 1 (got " +
                        std::to_string(p.k_neighbours) + ")");
   if (!(p.std_ratio > 0))
     throw InvalidInput("[removeStatisticalOutliers] std_ratio must be > 0 (got " + std::to_string(p.std_ratio) + ")");
-  const size_t k = static_cast<size_t>(p.k_neighbours) + 1;  // the point itself is row[0]
+  const size_t k = static_cast<size_t>(p.k_neighbours) + 1;
   if (cloud.size() < k)
     throw InvalidInput("[removeStatisticalOutliers] cloud has " + std::to_string(cloud.size()) +
                        " points, needs more than k_neighbours = " + std::to_string(p.k_neighbours));
-  const NeighbourTable table = nearestNeighbours(cloud.points, k, progress);
+}
+
+void checkRadius(const Cloud& cloud, const RadiusOutlierParams& p) {
+  if (p.radius_m < 0 || !std::isfinite(p.radius_m))
+    throw InvalidInput("[removeRadiusOutliers] radius_m must be >= 0 (got " + std::to_string(p.radius_m) + ")");
+  if (p.min_neighbours < 1)
+    throw InvalidInput("[removeRadiusOutliers] min_neighbours must be >= 1 (got " +
+                       std::to_string(p.min_neighbours) + ")");
+  if (cloud.size() < 2) throw InvalidInput("[removeRadiusOutliers] cloud has fewer than 2 points");
+}
+
+void checkTable(const char* function, const Cloud& cloud, const NeighbourTable& table, size_t k) {
+  if (table.size() != cloud.size() || table.k < k)
+    throw InvalidInput(std::string("[") + function + "] neighbour table (" + std::to_string(table.size()) +
+                       " rows, k = " + std::to_string(table.k) + ") does not match the cloud (" +
+                       std::to_string(cloud.size()) + " points, needs " + std::to_string(k) + " columns)");
+}
+
+}  // namespace
+
+Cleaning removeStatisticalOutliers(const Cloud& cloud, const StatisticalOutlierParams& p, const Progress& progress) {
+  checkStatistical(cloud, p);
+  return removeStatisticalOutliers(cloud, nearestNeighbours(cloud.points, static_cast<size_t>(p.k_neighbours) + 1, progress),
+                                   p, progress);
+}
+
+Cleaning removeStatisticalOutliers(const Cloud& cloud, const NeighbourTable& table, const StatisticalOutlierParams& p,
+                                   const Progress& progress) {
+  checkStatistical(cloud, p);
+  const size_t k = static_cast<size_t>(p.k_neighbours) + 1;  // the point itself is row[0]
+  checkTable("removeStatisticalOutliers", cloud, table, k);
   std::vector<double> mean_d(cloud.size());
   const long n = static_cast<long>(cloud.size());
 #pragma omp parallel for schedule(static)
@@ -46,12 +77,16 @@ Cleaning removeStatisticalOutliers(const Cloud& cloud, const StatisticalOutlierP
 }
 
 Cleaning removeRadiusOutliers(const Cloud& cloud, const RadiusOutlierParams& p, const Progress& progress) {
-  if (p.radius_m < 0 || !std::isfinite(p.radius_m))
-    throw InvalidInput("[removeRadiusOutliers] radius_m must be >= 0 (got " + std::to_string(p.radius_m) + ")");
-  if (p.min_neighbours < 1)
-    throw InvalidInput("[removeRadiusOutliers] min_neighbours must be >= 1 (got " +
-                       std::to_string(p.min_neighbours) + ")");
-  if (cloud.size() < 2) throw InvalidInput("[removeRadiusOutliers] cloud has fewer than 2 points");
+  checkRadius(cloud, p);
+  const size_t need = static_cast<size_t>(p.min_neighbours) + 1;
+  if (cloud.size() < need) return removeRadiusOutliers(cloud, NeighbourTable{}, p, progress);
+  // The (min_neighbours + 1)-th nearest point decides: within the radius or not.
+  return removeRadiusOutliers(cloud, nearestNeighbours(cloud.points, need, progress), p, progress);
+}
+
+Cleaning removeRadiusOutliers(const Cloud& cloud, const NeighbourTable& table, const RadiusOutlierParams& p,
+                              const Progress& progress) {
+  checkRadius(cloud, p);
   const size_t need = static_cast<size_t>(p.min_neighbours) + 1;
   Cleaning result;
   if (cloud.size() < need) {
@@ -60,8 +95,7 @@ Cleaning removeRadiusOutliers(const Cloud& cloud, const RadiusOutlierParams& p, 
     result.warnings.push_back("cloud smaller than min_neighbours + 1: every point removed");
     return result;
   }
-  // The (min_neighbours + 1)-th nearest point decides: within the radius or not.
-  const NeighbourTable table = nearestNeighbours(cloud.points, need, progress);
+  checkTable("removeRadiusOutliers", cloud, table, need);
   double radius = p.radius_m;
   if (radius == 0) {
     radius = 4.0 * medianSpacing(table);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "analysis/cloud.hpp"
+#include "analysis/neighbours.hpp"
 #include "analysis/progress.hpp"
 
 namespace sailshape {
@@ -24,6 +25,10 @@ struct StatisticalOutlierParams {
 };
 Cleaning removeStatisticalOutliers(const Cloud& cloud, const StatisticalOutlierParams& params = {},
                                    const Progress& progress = {});
+// Same, reusing the cloud's neighbour table (nearestNeighbours) with more than
+// params.k_neighbours columns.
+Cleaning removeStatisticalOutliers(const Cloud& cloud, const NeighbourTable& table,
+                                   const StatisticalOutlierParams& params = {}, const Progress& progress = {});
 
 // Removes points with fewer than min_neighbours other points within radius_m.
 // radius_m = 0 picks 4 × the median nearest-neighbour spacing.
@@ -32,6 +37,9 @@ struct RadiusOutlierParams {
   int min_neighbours = 4;
 };
 Cleaning removeRadiusOutliers(const Cloud& cloud, const RadiusOutlierParams& params = {},
+                              const Progress& progress = {});
+// Same, reusing the cloud's neighbour table with more than params.min_neighbours columns.
+Cleaning removeRadiusOutliers(const Cloud& cloud, const NeighbourTable& table, const RadiusOutlierParams& params = {},
                               const Progress& progress = {});
 
 // Points the outlier filters removed only for being sparse (the narrow tip of a

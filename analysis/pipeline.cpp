@@ -79,7 +79,8 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     // Work on a voxel-grid sample when the scan is denser than the voxel.
     const double voxel = p.segmentation_voxel_sigmas * p.sensor_sigma_m;
     VoxelSample sample;
-    const bool thin = voxel > 0 && medianNeighbourDistance(KdTree(cloud.points), cloud.points, 2) < 0.8 * voxel;
+    const bool thin =
+        voxel > 0 && medianNeighbourDistance(*gridForNeighbours(cloud.points, 2), cloud.points, 2) < 0.8 * voxel;
     if (thin) sample = voxelSample(cloud, voxel);
     const Cloud& seg_cloud = thin ? sample.cloud : cloud;
     const size_t k = static_cast<size_t>(std::max(p.normals.k_neighbours, p.region_growing.k_neighbours));
@@ -115,15 +116,28 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     kept = std::move(next);
     cloud = selectPoints(segmented, kept);
   };
+  // Both outlier tests read one neighbour table: the radius test's rows on what the
+  // statistical test kept are the kept part of the same rows.
+  const size_t stat_k = static_cast<size_t>(std::max(0, p.statistical.k_neighbours)) + 1;
+  const size_t radius_k = static_cast<size_t>(std::max(0, p.radius.min_neighbours)) + 1;
+  const size_t table_k = std::max(p.statistical_outliers ? stat_k : 0, p.radius_outliers ? radius_k : 0);
+  const bool share = p.statistical_outliers && p.radius_outliers && table_k <= cloud.size() &&
+                     p.statistical.k_neighbours >= 1 && p.radius.min_neighbours >= 1;
+  NeighbourTable table;
   if (p.statistical_outliers) {
     StageTimer t(a, "statistical outliers", cloud.size());
-    const Cleaning c = removeStatisticalOutliers(cloud, p.statistical, progress);
+    if (share) table = nearestNeighbours(cloud.points, table_k, progress);
+    const Cleaning c = share ? removeStatisticalOutliers(cloud, table, p.statistical, progress)
+                             : removeStatisticalOutliers(cloud, p.statistical, progress);
+    table = share && c.kept.size() >= radius_k ? subsetTable(table, cloud.points, c.kept, radius_k) : NeighbourTable{};
     keepOnly(c.kept);
     t.finish(cloud.size(), c.warnings);
   }
   if (p.radius_outliers) {
     StageTimer t(a, "radius outliers", cloud.size());
-    const Cleaning c = removeRadiusOutliers(cloud, p.radius, progress);
+    const Cleaning c = table.size() == cloud.size() && table.k >= radius_k
+                           ? removeRadiusOutliers(cloud, table, p.radius, progress)
+                           : removeRadiusOutliers(cloud, p.radius, progress);
     keepOnly(c.kept);
     t.finish(cloud.size(), c.warnings);
   }

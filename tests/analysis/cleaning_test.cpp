@@ -265,5 +265,36 @@ TEST(ReadmitSurfacePoints, RejectsBadParametersAndIndices) {
   EXPECT_THROW(readmitSurfacePoints(w.cloud, outside, p), InvalidInput);
 }
 
+TEST(OutlierRemoval, OneSharedTableGivesWhatEachTestFindsAlone) {
+  // The pipeline's path: a table with enough columns for both tests, the statistical
+  // test, then the radius test on the kept part of the same rows.
+  // No outliers and a tight ratio: the statistical test removes the upper tail of the
+  // plane's own points (about 16 % beyond mean + 1 std), so kept rows lose neighbours.
+  const PlaneWithOutliers s = planeWithOutliers(8000, 0, 8);
+  const StatisticalOutlierParams sp{10, 1.0};
+  const RadiusOutlierParams rp;
+  const NeighbourTable table = nearestNeighbours(s.cloud.points, 11);
+  const Cleaning alone = removeStatisticalOutliers(s.cloud, sp);
+  const Cleaning shared = removeStatisticalOutliers(s.cloud, table, sp);
+  EXPECT_EQ(shared.kept, alone.kept);
+  EXPECT_EQ(shared.removed, alone.removed);
+  EXPECT_DOUBLE_EQ(shared.threshold_m, alone.threshold_m);
+  ASSERT_GT(alone.removed.size(), 500u);
+
+  Cloud kept;
+  for (uint32_t i : alone.kept) kept.points.push_back(s.cloud.points[i]);
+  const NeighbourTable sub = subsetTable(table, s.cloud.points, alone.kept, 5);
+  const Cleaning radius_alone = removeRadiusOutliers(kept, rp);
+  const Cleaning radius_shared = removeRadiusOutliers(kept, sub, rp);
+  EXPECT_EQ(radius_shared.kept, radius_alone.kept);
+  EXPECT_DOUBLE_EQ(radius_shared.threshold_m, radius_alone.threshold_m);
+
+  const NeighbourTable too_narrow = nearestNeighbours(s.cloud.points, 4);
+  expectInvalidInput([&] { removeStatisticalOutliers(s.cloud, too_narrow, sp); },
+                     {"[removeStatisticalOutliers]", "k = 4", "needs 11 columns"});
+  expectInvalidInput([&] { removeRadiusOutliers(kept, too_narrow, rp); },
+                     {"[removeRadiusOutliers]", "does not match the cloud"});
+}
+
 }  // namespace
 }  // namespace sailshape
