@@ -240,9 +240,11 @@ TEST(ReadmitSurfacePoints, BringsBackTheSparseTipTheFiltersCutAndKeepsOutliersOu
   // Every inlier within 2σ of the plane is on the surface by any account: all of
   // them are back, the tip's included (the plane through 12 neighbours is itself
   // known to about σ/√12, so the 3σ limit leaves them a clear margin).
-  for (uint32_t i = 0; i < w.cloud.size(); ++i)
-    if (!w.outliers.count(i) && w.offset[i] <= 2.0)
+  for (uint32_t i = 0; i < w.cloud.size(); ++i) {
+    if (!w.outliers.count(i) && w.offset[i] <= 2.0) {
       EXPECT_TRUE(back.count(i)) << "inlier " << i << " at " << -w.cloud.points[i].y() << " m from the apex";
+    }
+  }
 }
 
 TEST(ReadmitSurfacePoints, RejectsBadParametersAndIndices) {
