@@ -79,8 +79,11 @@ bool PrivateDisplay::startXvfb(const std::string& xvfb, const std::string& numbe
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0)
     throw DisplayError(std::string("[PrivateDisplay] pipe: ") + std::strerror(errno));
+  // -noreset: an X server resets when its last client disconnects, and a client that
+  // connects during the reset fails ("bad X server connection", and VTK aborts). Each
+  // render window, and the readiness check below, is such a last client.
   std::vector<std::string> args = {xvfb, ":" + number, "-displayfd", "3", "-screen", "0", "1280x1024x24",
-                                   "-nolisten", "tcp"};
+                                   "-nolisten", "tcp", "-noreset"};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
