@@ -42,6 +42,20 @@ double encoderDeg(const ScanData& s) {
   return countsToDeg(static_cast<int32_t>(s.encoders.front().position));
 }
 
+// One scan line's points for watching the sweep: β from the scan's encoder reading when
+// β comes from the encoder, else the turntable's latest reported angle, for every beam.
+std::vector<Vec3> previewPoints(const UnitConfig& unit, const ScanData& s, double table_deg) {
+  std::vector<Vec3> out;
+  const ScanChannel* dist = s.channel("DIST1");
+  if (!dist) return out;
+  const bool encoder = unit.beta_source == BetaSource::Encoder && !s.encoders.empty();
+  const double beta = (encoder ? encoderDeg(s) : table_deg) * kDeg;
+  out.reserve(dist->values.size());
+  for (size_t i = 0; i < dist->values.size(); ++i)
+    if (dist->values[i] != 0) out.push_back(sweepPointPosition(unit, scanRangeMm(*dist, i) / 1000.0, scanAngleRad(*dist, i), beta));
+  return out;
+}
+
 
 }  // namespace
 
@@ -127,6 +141,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     }
     try {
       ScanData s = scanner.nextScan();
+      if (options.on_scan) options.on_scan(previewPoints(unit, s, table_samples.back().deg));
       scans.push_back({std::move(s), hostTimeSeconds()});
     } catch (const ScannerError& e) {
       sweep.partial = true;

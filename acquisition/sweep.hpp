@@ -25,6 +25,11 @@ struct SweepOptions {
   // Called once the unit stands at its start angle with scans streaming, just before the sweep move;
   // returns the trigger's time (host seconds) to record, e.g. by waiting for a UDP trigger.
   std::function<double()> wait_for_start;
+  // Called with each scan line's points as it arrives, to watch the cloud grow. A preview:
+  // β is the scan's encoder reading or the turntable's latest reported angle, held for the
+  // whole line (the sweep's cloud interpolates β per beam). Several units' sweeps call it
+  // from their own threads at once.
+  std::function<void(const std::vector<Vec3>& points)> on_scan;
 };
 
 // One sample; the sweep keeps every valid return.

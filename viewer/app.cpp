@@ -346,6 +346,21 @@ void App::pollJobs() {
   }
 
   const JobStatus ss = scanner_.scan_task.status();
+  if (ss.state == JobState::Running) {
+    // The cloud grows in the 3D view as the scan lines come in.
+    constexpr double kArrivingRefreshS = 0.25;
+    const double now = ImGui::GetTime();
+    if (now - scanner_.arriving_shown_s >= kArrivingRefreshS) {
+      if (auto pts = scanner_.arriving->newerThan(scanner_.arriving_seen)) {
+        StageResult preview;
+        preview.cloud.points = std::move(*pts);
+        preview.cloud = thinCloud(preview.cloud, 300'000);
+        scanner_.preview = std::move(preview);
+        scanner_.arriving_shown_s = now;
+        view_.rebuild = true;
+      }
+    }
+  }
   if (ss.state != JobState::Running && ss.state != JobState::Idle) {
     if (auto a = scanner_.scan_task.take()) {
       scanner_.note = std::to_string(a->cloud.size()) + " points from " + std::to_string(a->sweeps.size()) + " unit(s)";
@@ -1248,9 +1263,11 @@ void App::drawScanner() {
     sc.preview.reset();
     view_.rebuild = true;
     const ScannerSession* session = &sc.session;
-    sc.scan_task.start("scan", [session](const Progress& p) {
+    sc.arriving->clear();
+    std::shared_ptr<ArrivingPoints> arriving = sc.arriving;
+    sc.scan_task.start("scan", [session, arriving](const Progress& p) {
       try {
-        return session->scan({}, p);
+        return session->scan(arriving->feeding(), p);
       } catch (const Cancelled&) {
         session->stopTurntables();  // the drives would refuse the next scan's homing while they still move
         throw;

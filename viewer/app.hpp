@@ -102,6 +102,10 @@ struct ScannerState {
   Task<std::string> home_task;
   std::optional<Acquisition> last;       // the latest scan, not yet saved
   std::optional<StageResult> preview;    // its cloud, shown in the 3D view
+  // The cloud as it arrives during a scan; shown at most every kArrivingRefreshS.
+  std::shared_ptr<ArrivingPoints> arriving = std::make_shared<ArrivingPoints>();
+  uint64_t arriving_seen = 0;
+  double arriving_shown_s = 0;
   std::string note;
 };
 

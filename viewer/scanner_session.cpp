@@ -161,6 +161,31 @@ Acquisition ScannerSession::scan(const SweepOptions& options, const Progress& pr
   return a;
 }
 
+void ArrivingPoints::clear() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  points_.clear();
+  ++version_;
+}
+
+void ArrivingPoints::add(const std::vector<Vec3>& points) {
+  if (points.empty()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  points_.insert(points_.end(), points.begin(), points.end());
+  ++version_;
+}
+
+std::optional<std::vector<Vec3>> ArrivingPoints::newerThan(uint64_t& seen) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (version_ == seen) return std::nullopt;
+  seen = version_;
+  return points_;
+}
+
+SweepOptions ArrivingPoints::feeding(SweepOptions options) {
+  options.on_scan = [this](const std::vector<Vec3>& points) { add(points); };
+  return options;
+}
+
 ImportResult saveAcquisition(Database& db, const Acquisition& acquisition, const TrimStepForm& form) {
   if (acquisition.cloud.empty()) throw InvalidInput("[saveAcquisition] the scan holds no point");
   ImportMetadata meta;

@@ -4,6 +4,7 @@
 // synchronised scan of every unit, and the trim-step data saved with it.
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -87,6 +88,23 @@ class ScannerSession {
 
  private:
   std::vector<ScannerUnitSlot> units_;
+};
+
+// The points of the scan lines received so far, filled from the sweeping threads
+// (SweepOptions::on_scan) while the UI thread watches the cloud grow.
+class ArrivingPoints {
+ public:
+  void clear();
+  void add(const std::vector<Vec3>& points);
+  // Every point so far, when more arrived since `seen` (which is then moved on); else nothing.
+  std::optional<std::vector<Vec3>> newerThan(uint64_t& seen) const;
+  // SweepOptions that add each arriving scan line here.
+  SweepOptions feeding(SweepOptions options = {});
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<Vec3> points_;
+  uint64_t version_ = 0;
 };
 
 // Stores the acquisition's cloud with the trim-step data (no analysis yet: the

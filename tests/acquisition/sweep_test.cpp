@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <chrono>
 #include <cmath>
 
 #include "acquisition/emulated_turntable.hpp"
@@ -131,6 +132,38 @@ TEST(Sweep, PlaneWithEncoderBeta) { checkPlaneSweep(BetaSource::Encoder); }
 TEST(Sweep, PlaneWithTimestampBeta) { checkPlaneSweep(BetaSource::Timestamp); }
 
 TEST(Sweep, PlaneInColaA) { checkPlaneSweep(BetaSource::Encoder, "cola-a"); }
+
+TEST(Sweep, ScanLinesArriveWhileTheTurntableMoves) {
+  UnitConfig u = compactUnit(0.12, 25);
+  u.beta_source = BetaSource::Encoder;
+  u.pose = makePose(Vec3(0.5, -1.0, 2.0), 0, 0, 0.3);
+  Scene scene;
+  const Vec3 c[4] = {Vec3(-20, 3, -20), Vec3(20, 3, -20), Vec3(20, 3, 20), Vec3(-20, 3, 20)};
+  scene.objects.push_back({"wall", Material::Cloth, makeQuad(u.pose * c[0], u.pose * c[1], u.pose * c[2], u.pose * c[3])});
+  Rig rig(scene, u, emulatorFor(u), fastTable());
+  SweepOptions o;
+  std::vector<Vec3> seen;
+  size_t calls = 0;
+  std::chrono::steady_clock::time_point first, last;
+  o.on_scan = [&](const std::vector<Vec3>& pts) {
+    last = std::chrono::steady_clock::now();
+    if (calls++ == 0) first = last;
+    seen.insert(seen.end(), pts.begin(), pts.end());
+  };
+  const Sweep s = runSweep(rig.unit, o);
+  ASSERT_FALSE(s.partial) << s.message;
+  // Every scan the sweep used was shown first (and those at the start angle before the move).
+  EXPECT_GE(calls, s.scans);
+  EXPECT_GE(seen.size(), s.cloud.size());
+  // Shown as they came: over the second the 40° take at 40 °/s, not all at the end.
+  EXPECT_GT(std::chrono::duration<double>(last - first).count(), 0.5);
+  // On the wall, up to holding β for a whole line: 40 °/s for 20 ms (0.8°) at up to 3.5 m, plus 4σ of noise.
+  const Vec3 n = u.pose.linear() * Vec3::UnitY(), on_wall = u.pose * Vec3(0, 3, 0);
+  const double limit = 3.5 * 0.8 * kDeg + 4 * kSigmaCloth;
+  size_t off = 0;
+  for (const Vec3& p : seen) off += std::abs((p - on_wall).dot(n)) > limit;
+  EXPECT_EQ(off, 0u) << "of " << seen.size() << " shown points";
+}
 
 TEST(Sweep, CylinderAtAKnownPosition) {
   // A vertical cylinder of radius 0.4 m, axis through (0.3, 3, ·) in the unit frame; no background.

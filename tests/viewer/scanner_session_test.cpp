@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <future>
 #include <cmath>
 #include <fstream>
 
@@ -111,6 +113,42 @@ TEST(ScannerSession, TheDeckUnitSeesTheMainsail) {
   for (const Vec3& p : a.cloud.points)
     if (std::abs(sail.signedDistance(p)) < 5 * kSigmaCloth) ++on_sail;
   EXPECT_GT(on_sail, a.cloud.size() / 5) << on_sail << " of " << a.cloud.size();
+}
+
+TEST(ScannerSession, TheCloudArrivesWhileTheUnitsSweep) {
+  // Two units, so the scan lines come from two sweeping threads at once.
+  ScannerSession session;
+  session.addEmulatedUnit(wallAt(3.0), "wall", compactUnit());
+  UnitConfig second = compactUnit();
+  second.name = "wall-unit-2";
+  session.addEmulatedUnit(wallAt(3.0), "wall", second);
+  ArrivingPoints arriving;
+  auto scan = std::async(std::launch::async, [&] { return session.scan(arriving.feeding()); });
+  // The UI's view of it: poll as the render loop does, and count the times it grew.
+  uint64_t seen = 0;
+  size_t growths = 0, shown = 0;
+  while (scan.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+    if (auto pts = arriving.newerThan(seen)) {
+      if (pts->size() > shown) ++growths;
+      shown = pts->size();
+    }
+  }
+  const Acquisition a = scan.get();
+  ASSERT_EQ(a.sweeps.size(), 2u);
+  ASSERT_GT(a.cloud.size(), 0u);
+  // The 1 s sweeps at 30 °/s were seen growing many times before the scan returned.
+  EXPECT_GE(growths, 5u);
+  EXPECT_GT(shown, 0u);
+  // In the end every point of the scan was shown (and those at the start angle before the move).
+  auto all = arriving.newerThan(seen);
+  const size_t total = all ? all->size() : shown;
+  EXPECT_GE(total, a.cloud.size());
+  // Nothing new: nothing returned.
+  EXPECT_FALSE(arriving.newerThan(seen).has_value());
+  arriving.clear();
+  auto cleared = arriving.newerThan(seen);
+  ASSERT_TRUE(cleared.has_value());
+  EXPECT_TRUE(cleared->empty());
 }
 
 TEST(ScannerSession, HomesAnEmulatedTurntable) {
