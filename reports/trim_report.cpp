@@ -165,9 +165,15 @@ class Pages {
     pdf_.addPage(landscape);
     const float w = pdf_.pageWidth(), h = pdf_.pageHeight();
     pdf_.rect(0, 0, w, 34, kNavy);
-    pdf_.text(kMargin, 22, title, 13, true, {1, 1, 1});
-    pdf_.text(w - kMargin, 22, d_.sail + (d_.boat.empty() ? "" : " · " + d_.boat), 9, false, {0.85, 0.9, 1},
-              Align::Right);
+    // The title shrinks (to 10 pt) to keep clear of the sail and boat on the right;
+    // when it still does not fit, the sail and boat go up to the band's top line.
+    const std::string who = d_.sail + (d_.boat.empty() ? "" : " · " + d_.boat);
+    const float room = w - 2 * kMargin - pdf_.textWidth(who, 9) - 12;
+    float size = 13;
+    while (size > 10 && pdf_.textWidth(title, size, true) > room) size -= 0.5f;
+    const bool beside = pdf_.textWidth(title, size, true) <= room;
+    pdf_.text(kMargin, beside ? 22 : 27, title, size, true, {1, 1, 1});
+    pdf_.text(w - kMargin, beside ? 22 : 11, who, beside ? 9 : 7.5f, false, {0.85, 0.9, 1}, Align::Right);
     pdf_.line(kMargin, h - 28, w - kMargin, h - 28, 0.4f, kRule);
     pdf_.text(kMargin, h - 16, "sailshape trim report · " + d_.campaign + (d_.test.empty() ? "" : " · test " + d_.test),
               7.5f, false, kGrey);

@@ -1,6 +1,8 @@
 // The PDF trim report built from a database with known values, read back with
 // poppler's pdftotext / pdfinfo / pdftoppm.
 #include <gtest/gtest.h>
+
+#include <regex>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -40,7 +42,8 @@ const auto* const kNoDisplay = ::testing::AddGlobalTestEnvironment(new NoDisplay
 
 constexpr int kSteps = 3, kSections = 8;
 const char* const kSail = "Grand-voile Été";
-const char* const kBoat = "Øresund Flyer";
+// Long enough to meet the page titles in the header band unless they make room.
+const char* const kBoat = "Øresund Flyer, 1:3.6 tunnel model of the 36 ft cruiser-racer";
 const char* const kCampaign = "Régates de Côte Bleue";
 const char* const kTest = "twist sweep";
 
@@ -148,6 +151,41 @@ std::string run(const std::string& cmd) {
 
 std::string pdfText(const std::string& pdf) { return run("pdftotext -layout '" + pdf + "' - 2>/dev/null"); }
 
+// Pairs of words in the header band (top 34 pt) of every page whose boxes overlap, as "page: a / b".
+std::vector<std::string> overlappingHeaderWords(const std::string& pdf) {
+  const std::string html = run("pdftotext -bbox '" + pdf + "' - 2>/dev/null");
+  struct Word {
+    double x0, y0, x1, y1;
+    std::string text;
+  };
+  std::vector<std::string> out;
+  std::vector<Word> words;
+  int page = 0;
+  const std::regex word_re(R"re(<word xMin="([0-9.]+)" yMin="([0-9.]+)" xMax="([0-9.]+)" yMax="([0-9.]+)">([^<]*)</word>)re");
+  auto flush = [&] {
+    for (size_t i = 0; i < words.size(); ++i)
+      for (size_t j = i + 1; j < words.size(); ++j) {
+        const Word &a = words[i], &b = words[j];
+        if (a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1)
+          out.push_back(std::to_string(page) + ": " + a.text + " / " + b.text);
+      }
+    words.clear();
+  };
+  std::istringstream in(html);
+  std::string line;
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (line.find("<page ") != std::string::npos) {
+      flush();
+      ++page;
+    }
+    if (std::regex_search(line, m, word_re) && std::stod(m[4]) <= 34)
+      words.push_back({std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]), m[5]});
+  }
+  flush();
+  return out;
+}
+
 int pdfPages(const std::string& pdf) {
   std::istringstream info(run("pdfinfo '" + pdf + "' 2>/dev/null"));
   std::string line;
@@ -246,6 +284,9 @@ TEST(TrimReport, DesignerReportShowsTheDatabaseNumbersAndBothColours) {
   const std::string text = pdfText(p.out_path);
   EXPECT_NE(text.find(kSail), std::string::npos);
   EXPECT_NE(text.find(kBoat), std::string::npos);
+  // Page titles and the sail and boat share the header band without running into each other.
+  const std::vector<std::string> clashes = overlappingHeaderWords(p.out_path);
+  EXPECT_TRUE(clashes.empty()) << clashes.size() << " overlapping header words, first " << clashes.front();
   EXPECT_NE(text.find(kCampaign), std::string::npos);
   EXPECT_NE(text.find("Voilerie Lætitia"), std::string::npos);
   for (int k = 0; k < kSteps; ++k)
