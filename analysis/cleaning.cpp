@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
 
 #include "analysis/errors.hpp"
+#include "analysis/plane_detection.hpp"
 
 namespace sailshape {
 
@@ -142,15 +142,10 @@ Cleaning readmitSurfacePoints(const Cloud& cloud, const std::vector<uint32_t>& k
         const Vec3& q = cloud.points[i];
         tree.nearest(q, k, idx, d2);
         if (idx.size() < 3 || std::sqrt(d2.front()) > max_gap) continue;
-        Vec3 centre = Vec3::Zero();
-        for (uint32_t j : idx) centre += pts[j];
-        centre /= static_cast<double>(idx.size());
-        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-        for (uint32_t j : idx) cov += (pts[j] - centre) * (pts[j] - centre).transpose();
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+        const DetectedPlane plane = fitPlane(pts, idx);
         // Neighbours along a line give no plane to test against.
-        if (eig.eigenvalues()(1) < 1e-6 * eig.eigenvalues()(2)) continue;
-        if (std::abs((q - centre).dot(eig.eigenvectors().col(0))) <= p.max_offset_m) back.push_back(i);
+        if (plane.width_m < 1e-3 * plane.extent_m) continue;
+        if (std::abs(plane.normal.dot(q) - plane.offset_m) <= p.max_offset_m) back.push_back(i);
       }
       return back;
     };
