@@ -8,8 +8,9 @@
 namespace sailshape {
 
 double distanceToSpar(const Vec3& p, const Spar& s) {
-  const double along = std::clamp((p - s.base).dot(s.axis), 0.0, s.length_m);
-  return (p - s.base - along * s.axis).norm() - s.radius_m;
+  const double along = (p - s.base).dot(s.axis);
+  const double radial = (p - s.base - along * s.axis).norm() - s.radius_m;
+  return std::max({radial, along - s.length_m, -along});
 }
 
 SparFit fitSpar(const Cloud& cloud, const Spar& nominal, const SparFitParams& p) {

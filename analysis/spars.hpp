@@ -40,7 +40,9 @@ struct SparFit {
 // found = false. Throws InvalidInput for a zero axis, length or radius.
 SparFit fitSpar(const Cloud& cloud, const Spar& nominal, const SparFitParams& params = {});
 
-// Distance from p to the spar's axis segment minus its radius: negative inside.
+// How far p lies outside the spar's round surface or beyond its end faces (the
+// larger of the two): negative inside. Below c means within c of the spar on
+// every side, the flat ends included.
 double distanceToSpar(const Vec3& p, const Spar& spar);
 
 }  // namespace sailshape

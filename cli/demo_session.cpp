@@ -239,11 +239,8 @@ Cloud cropToSail(const Cloud& cloud, const Mesh& design, double margin_m, double
   box.min().array() -= margin_m;
   box.max().array() += margin_m;
   auto nearSpar = [&](const Vec3& p) {
-    for (const Spar& s : spars) {
-      const double along = (p - s.base).dot(s.axis);
-      if (along < -clearance_m || along > s.length_m + clearance_m) continue;
-      if ((p - s.base - along * s.axis).norm() < s.radius_m + clearance_m) return true;
-    }
+    for (const Spar& s : spars)
+      if (distanceToSpar(p, s) < clearance_m) return true;
     return false;
   };
   std::vector<uint32_t> keep;
