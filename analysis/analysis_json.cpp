@@ -78,6 +78,15 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
                         {"tilt_from_vertical_deg", c.tilt_from_vertical_deg},
                         {"sail_like", c.sail_like},
                         {"reason", c.reason}});
+  nlohmann::json spars = nlohmann::json::array();
+  for (const SparFit& f : a.spars) {
+    const Vec3 top = f.spar.base + f.spar.length_m * f.spar.axis;
+    spars.push_back({{"base", {f.spar.base.x(), f.spar.base.y(), f.spar.base.z()}},
+                     {"top", {top.x(), top.y(), top.z()}},
+                     {"radius_m", f.spar.radius_m},
+                     {"support", f.support},
+                     {"rms_m", f.rms_m}});
+  }
   const Smoothing& sm = a.smoothing_stats;
   j["diagnostics"] = {{"points_in", a.points_in},
                       {"sail_points", a.sail_points},
@@ -85,6 +94,7 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
                       {"mesh_triangles", a.mesh.triangles.size()},
                       {"stages", stages},
                       {"clusters", clusters},
+                      {"spars", spars},
                       {"smoothing", {{"good", sm.good},
                                      {"fair", sm.fair},
                                      {"bad", sm.bad},

@@ -15,6 +15,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegionGrowingParams, k_neighbour
                                                 min_points, max_points)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SailPickParams, method, seed_point, cluster_index, min_depth_m,
                                                 min_depth_ratio, min_extent_m, max_tilt_deg)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SparSearchParams, min_radius_m, max_radius_m, min_length_radii,
+                                                min_arc_deg, min_support, hypotheses, max_spars, seed)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StatisticalOutlierParams, k_neighbours, std_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RadiusOutlierParams, radius_m, min_neighbours)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ReadmitParams, k_neighbours, max_offset_m, max_gap_factor, passes)
@@ -29,7 +31,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions,
                                                 noise_correlation_m, curve_points)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, normals, segment,
                                                 segmentation_voxel_sigmas, region_growing,
-                                                sail_pick, statistical_outliers, statistical, radius_outliers, radius,
+                                                sail_pick, find_spars, spars, statistical_outliers, statistical, radius_outliers, radius,
                                                 readmit_surface_points, readmit, smooth, smoothing, surface, outline, sections)
 
 namespace {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "analysis/errors.hpp"
@@ -61,6 +62,62 @@ VoxelSample voxelSample(const Cloud& in, double voxel) {
   return out;
 }
 
+// Finds round spars among the points near the sail cluster `sail` (indices into
+// `cloud`); when there are any, the sail loses its points on them and gains the
+// unclustered points that lie on its surface and off every spar: the strip along
+// an edge whose neighbourhoods reached onto the spar. Returns the new cluster.
+std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const Segmentation& seg,
+                                    const std::vector<uint32_t>& sail, const AnalysisParams& p, SailAnalysis& a) {
+  std::vector<char> in_sail(cloud.size(), 0);
+  Eigen::AlignedBox3d box;
+  for (uint32_t i : sail) {
+    in_sail[i] = 1;
+    box.extend(cloud.points[i]);
+  }
+  SparSearchParams sp = p.spars;
+  sp.sensor_sigma_m = p.sensor_sigma_m;
+  // A spar within reach of the sail has its whole girth inside the grown box.
+  const double reach = 2 * sp.max_radius_m + 0.1;
+  box.min() -= Vec3::Constant(reach);
+  box.max() += Vec3::Constant(reach);
+  std::vector<uint32_t> near;
+  for (uint32_t i = 0; i < cloud.size(); ++i)
+    if (!in_sail[i] && box.contains(cloud.points[i])) near.push_back(i);
+  const SparSearch found = findSpars(cloud, normals, near, sp);
+  a.spars = found.spars;
+  if (found.spars.empty()) return sail;
+  const double sigma = p.sensor_sigma_m;
+  auto nearestSpar = [&](const Vec3& x) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const SparFit& f : found.spars) d = std::min(d, distanceToSpar(x, f.spar));
+    return d;
+  };
+  // Sail points within 2σ of a spar's surface are more likely the spar's; loose
+  // points within 3σ of it stay out (the sail is at least 2 cm off a mast's aft face).
+  std::vector<uint32_t> sub;
+  for (uint32_t i : sail)
+    if (nearestSpar(cloud.points[i]) > 2 * sigma) sub.push_back(i);
+  const size_t sail_kept = sub.size();
+  for (uint32_t i : seg.unassigned)
+    if (!in_sail[i] && box.contains(cloud.points[i]) && nearestSpar(cloud.points[i]) > 3 * sigma) sub.push_back(i);
+  if (sub.size() == sail_kept || sail_kept == 0) return sub;
+  std::vector<uint32_t> order(sub.size());
+  for (uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return sub[x] < sub[y]; });
+  std::vector<uint32_t> sorted_sub(sub.size()), kept;
+  for (uint32_t k = 0; k < order.size(); ++k) {
+    sorted_sub[k] = sub[order[k]];
+    if (order[k] < sail_kept) kept.push_back(k);
+  }
+  ReadmitParams rp = p.readmit;
+  if (!(rp.max_offset_m > 0)) rp.max_offset_m = 3 * sigma;
+  const Cleaning back = readmitSurfacePoints(selectPoints(cloud, sorted_sub), kept, rp);
+  std::vector<uint32_t> out;
+  out.reserve(back.kept.size());
+  for (uint32_t k : back.kept) out.push_back(sorted_sub[k]);
+  return out;
+}
+
 }  // namespace
 
 SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
@@ -90,6 +147,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     const SailPick pick = pickSailCluster(seg_cloud, seg, p.sail_pick);
     a.clusters = pick.candidates;
     std::vector<uint32_t> idx = addClusterFringe(seg, pick.cluster, table);
+    if (p.find_spars) idx = separateSpars(seg_cloud, normals.normals.normals, seg, idx, p, a);
     if (thin) {
       std::vector<char> in(sample.cloud.size(), 0);
       for (uint32_t v : idx) in[v] = 1;

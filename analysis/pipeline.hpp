@@ -14,6 +14,7 @@
 #include "analysis/sections.hpp"
 #include "analysis/segmentation.hpp"
 #include "analysis/smoothing.hpp"
+#include "analysis/spars.hpp"
 #include "analysis/surface.hpp"
 
 namespace sailshape {
@@ -28,6 +29,11 @@ struct AnalysisParams {
   double segmentation_voxel_sigmas = 5.0;
   RegionGrowingParams region_growing;
   SailPickParams sail_pick;
+  // Round spars (mast, boom) found beside the picked sail: points on them leave the
+  // sail, and the sail's edge strip whose neighbourhoods mixed in spar points comes
+  // back where it lies on the sail's surface. Its sensor_sigma_m follows the one above.
+  bool find_spars = true;
+  SparSearchParams spars;
   bool statistical_outliers = true;
   StatisticalOutlierParams statistical;
   bool radius_outliers = true;
@@ -58,6 +64,7 @@ struct SailAnalysis {
   LuffCurve luff;
   Smoothing smoothing_stats;         // displacement classes (cloud emptied to save memory)
   std::vector<ClusterInfo> clusters; // what segmentation found
+  std::vector<SparFit> spars;        // round spars found beside the sail
   std::vector<StageReport> stages;
   std::vector<std::string> warnings; // every stage's warnings, prefixed by stage
 };

@@ -1,7 +1,10 @@
 #include "analysis/spars.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
+#include <random>
 
 #include "analysis/errors.hpp"
 
@@ -98,6 +101,193 @@ SparFit fitSpar(const Cloud& cloud, const Spar& nominal, const SparFitParams& p)
     fit.message = "spar '" + s.name + "': the refined fit keeps only " + std::to_string(n) + " supporting points";
   }
   return fit;
+}
+
+namespace {
+
+// An infinite round cylinder: a point on its axis, the unit axis and the radius.
+struct Cylinder {
+  Vec3 point = Vec3::Zero(), axis = Vec3::UnitZ();
+  double radius = 0;
+};
+
+double radialResidual(const Vec3& p, const Cylinder& c) {
+  const Vec3 d = p - c.point;
+  return (d - d.dot(c.axis) * c.axis).norm() - c.radius;
+}
+
+// The cylinder through two surface points with their normals: the axis is
+// across both normals, and in the plane across the axis both normal lines pass
+// through the centre. Nothing when the normals are too near parallel to give an
+// axis or the two radii disagree.
+std::optional<Cylinder> cylinderThrough(const Vec3& p1, const Vec3& n1, const Vec3& p2, const Vec3& n2,
+                                        double tolerance_m) {
+  Vec3 axis = n1.cross(n2);
+  const double s = axis.norm();
+  if (s < 0.25) return std::nullopt;  // normals within ~15° of each other
+  axis /= s;
+  const Vec3 m1 = (n1 - n1.dot(axis) * axis).normalized(), m2 = (n2 - n2.dot(axis) * axis).normalized();
+  const Vec3 q1 = p1 - p1.dot(axis) * axis, q2 = p2 - p2.dot(axis) * axis;
+  Eigen::Matrix<double, 3, 2> M;
+  M.col(0) = m1;
+  M.col(1) = -m2;
+  const Eigen::Vector2d tu = M.colPivHouseholderQr().solve(q2 - q1);
+  const double r1 = std::abs(tu(0)), r2 = std::abs(tu(1));
+  if (std::abs(r1 - r2) > tolerance_m + 0.25 * std::max(r1, r2)) return std::nullopt;
+  Cylinder c;
+  c.axis = axis;
+  c.point = q1 + tu(0) * m1;
+  c.radius = 0.5 * (r1 + r2);
+  return c;
+}
+
+// Along-axis position and angle around the axis of p.
+struct AxialPosition {
+  double along, angle;
+};
+AxialPosition axialPosition(const Vec3& p, const Cylinder& c) {
+  const Vec3 u = c.axis.unitOrthogonal(), v = c.axis.cross(u);
+  const Vec3 d = p - c.point;
+  return {d.dot(c.axis), std::atan2(d.dot(v), d.dot(u))};
+}
+
+// Covered arc in degrees: the 10° sectors holding at least a tenth of an even share of the points.
+double coveredArcDeg(const std::vector<double>& angles) {
+  std::array<size_t, 36> bins{};
+  for (double a : angles) {
+    const int b = static_cast<int>(std::floor((a + M_PI) / (2 * M_PI) * 36.0));
+    ++bins[static_cast<size_t>(std::clamp(b, 0, 35))];
+  }
+  const double need = std::max(3.0, 0.1 * static_cast<double>(angles.size()) / 36.0);
+  return 10.0 * static_cast<double>(std::count_if(bins.begin(), bins.end(), [&](size_t n) { return n >= need; }));
+}
+
+// Gauss–Newton on the axis position (2), direction (2) and radius (1) over the points
+// within `band` of the current surface, re-selecting them each round.
+Cylinder refineCylinder(const std::vector<Vec3>& pts, Cylinder c, double band) {
+  for (int it = 0; it < 12; ++it) {
+    std::vector<const Vec3*> in;
+    Vec3 centroid = Vec3::Zero();
+    for (const Vec3& p : pts)
+      if (std::abs(radialResidual(p, c)) <= band) {
+        in.push_back(&p);
+        centroid += p;
+      }
+    if (in.size() < 6) break;
+    centroid /= static_cast<double>(in.size());
+    c.point += (centroid - c.point).dot(c.axis) * c.axis;  // keep the axis point among the points
+    const Vec3 u = c.axis.unitOrthogonal(), v = c.axis.cross(u);
+    auto moved = [&](const Eigen::Matrix<double, 5, 1>& x) {
+      Cylinder m;
+      m.point = c.point + x(0) * u + x(1) * v;
+      m.axis = (c.axis + x(2) * u + x(3) * v).normalized();
+      m.radius = c.radius + x(4);
+      return m;
+    };
+    Eigen::Matrix<double, 5, 5> A = Eigen::Matrix<double, 5, 5>::Zero();
+    Eigen::Matrix<double, 5, 1> b = Eigen::Matrix<double, 5, 1>::Zero();
+    const double h = 1e-6;
+    std::array<Cylinder, 5> stepped;
+    for (int k = 0; k < 5; ++k) {
+      Eigen::Matrix<double, 5, 1> x = Eigen::Matrix<double, 5, 1>::Zero();
+      x(k) = h;
+      stepped[static_cast<size_t>(k)] = moved(x);
+    }
+    for (const Vec3* p : in) {
+      const double r0 = radialResidual(*p, c);
+      Eigen::Matrix<double, 5, 1> g;
+      for (int k = 0; k < 5; ++k) g(k) = (radialResidual(*p, stepped[static_cast<size_t>(k)]) - r0) / h;
+      A += g * g.transpose();
+      b -= g * r0;
+    }
+    const Eigen::Matrix<double, 5, 1> dx = A.ldlt().solve(b);
+    if (!dx.allFinite()) break;
+    c = moved(dx);
+    if (dx.head<2>().norm() < 1e-6 && dx.segment<2>(2).norm() < 1e-7 && std::abs(dx(4)) < 1e-6) break;
+  }
+  return c;
+}
+
+}  // namespace
+
+SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const std::vector<uint32_t>& candidates,
+                     const SparSearchParams& p) {
+  if (normals.size() != cloud.size())
+    throw InvalidInput("[findSpars] " + std::to_string(normals.size()) + " normals for " +
+                       std::to_string(cloud.size()) + " points");
+  if (!(p.sensor_sigma_m > 0) || !(p.min_radius_m > 0) || !(p.max_radius_m > p.min_radius_m) ||
+      p.hypotheses < 1 || p.max_spars < 0)
+    throw InvalidInput("[findSpars] needs sensor_sigma_m > 0, 0 < min_radius_m < max_radius_m, hypotheses >= 1");
+  for (uint32_t i : candidates)
+    if (i >= cloud.size())
+      throw InvalidInput("[findSpars] candidate index " + std::to_string(i) + " beyond the cloud's " +
+                         std::to_string(cloud.size()) + " points");
+  SparSearch out;
+  const double band = 2 * p.sensor_sigma_m;
+  std::vector<uint32_t> pool = candidates;
+  std::mt19937 rng(p.seed);
+  for (int s = 0; s < p.max_spars && pool.size() >= std::max<size_t>(p.min_support, 2); ++s) {
+    std::vector<Vec3> pts;
+    pts.reserve(pool.size());
+    for (uint32_t i : pool) pts.push_back(cloud.points[i]);
+    // Score hypotheses on at most 20,000 of the points (every n-th); refine on all.
+    const size_t stride = std::max<size_t>(1, pts.size() / 20000);
+    std::uniform_int_distribution<size_t> pick(0, pool.size() - 1);
+    std::optional<Cylinder> best;
+    size_t best_score = 0;
+    for (int h = 0; h < p.hypotheses; ++h) {
+      const size_t i = pick(rng), j = pick(rng);
+      if (i == j) continue;
+      const auto c = cylinderThrough(pts[i], normals[pool[i]], pts[j], normals[pool[j]], 4 * p.sensor_sigma_m);
+      if (!c || c->radius < p.min_radius_m || c->radius > p.max_radius_m) continue;
+      size_t score = 0;
+      for (size_t k = 0; k < pts.size(); k += stride) score += std::abs(radialResidual(pts[k], *c)) <= band;
+      if (score > best_score) {
+        best_score = score;
+        best = c;
+      }
+    }
+    if (!best || best_score * stride < p.min_support) break;
+    const Cylinder c = refineCylinder(pts, refineCylinder(pts, *best, 3 * band), band);
+    std::vector<double> along, angle;
+    double sum2 = 0;
+    for (const Vec3& x : pts) {
+      const double r = radialResidual(x, c);
+      if (std::abs(r) > band) continue;
+      const AxialPosition a = axialPosition(x, c);
+      along.push_back(a.along);
+      angle.push_back(a.angle);
+      sum2 += r * r;
+    }
+    if (along.size() < p.min_support || !(c.radius >= p.min_radius_m && c.radius <= p.max_radius_m)) break;
+    std::vector<double> sorted = along;
+    std::sort(sorted.begin(), sorted.end());
+    // The spar runs as far as its points do without a gap: out from the median, up to the
+    // last point before a gap of more than two diameters (an infinite cylinder also grazes
+    // whatever lies further along its line).
+    const double max_gap = 4 * c.radius + 2 * band;
+    size_t first = sorted.size() / 2, last = first;
+    while (first > 0 && sorted[first] - sorted[first - 1] <= max_gap) --first;
+    while (last + 1 < sorted.size() && sorted[last + 1] - sorted[last] <= max_gap) ++last;
+    const double lo = sorted[first], hi = sorted[last];
+    if (hi - lo < p.min_length_radii * c.radius || coveredArcDeg(angle) < p.min_arc_deg) break;
+    SparFit fit;
+    fit.found = true;
+    fit.support = along.size();
+    fit.rms_m = std::sqrt(sum2 / static_cast<double>(along.size()));
+    fit.spar.name = "spar " + std::to_string(s + 1);
+    fit.spar.axis = c.axis;
+    fit.spar.base = c.point + lo * c.axis;
+    fit.spar.length_m = hi - lo;
+    fit.spar.radius_m = c.radius;
+    out.spars.push_back(fit);
+    // The next spar is searched among the points this one does not hold.
+    std::vector<uint32_t> rest;
+    for (size_t k = 0; k < pool.size(); ++k)
+      if (std::abs(distanceToSpar(pts[k], fit.spar)) > 3 * band) rest.push_back(pool[k]);
+    pool = std::move(rest);
+  }
+  return out;
 }
 
 }  // namespace sailshape

@@ -45,4 +45,35 @@ SparFit fitSpar(const Cloud& cloud, const Spar& nominal, const SparFitParams& pa
 // every side, the flat ends included.
 double distanceToSpar(const Vec3& p, const Spar& spar);
 
+// Finding spars nobody gave a place for: in a scene analysed without the rig's
+// measurements, the mast 2 cm forward of the luff mixes into the neighbourhoods of
+// the sail's luff strip; knowing the mast's round surface lets that strip come back
+// without the mast's aft face, which lies in the sail's plane extended.
+struct SparSearchParams {
+  double sensor_sigma_m = 0.004;  // SPEC §3; a point within 2σ of the round surface supports it
+  double min_radius_m = 0.01;
+  double max_radius_m = 0.25;
+  double min_length_radii = 8;    // a spar is long: its supported length is at least this × its radius
+  double min_arc_deg = 100;       // the supporting points cover at least this much of the circumference
+                                  // (a scanner sees about half of it; a strip of a flat surface far less)
+  size_t min_support = 100;
+  int hypotheses = 400;           // random two-point samples per spar
+  int max_spars = 3;
+  unsigned seed = 1;              // the sampling's seed: the same cloud gives the same spars
+};
+
+struct SparSearch {
+  std::vector<SparFit> spars;     // found ones only, most supported first
+  std::vector<std::string> warnings;
+};
+
+// Round spars among cloud.points[candidates]: two points and their normals give a
+// cylinder (its axis is across both normals), the hypothesis most candidates fit wins and
+// is refined by least squares on its axis, direction and radius; its points are taken
+// out and the next spar searched, up to max_spars. `normals` has one per cloud point.
+// Throws InvalidInput for a normals/cloud size mismatch, an index out of range or bad
+// parameters.
+SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const std::vector<uint32_t>& candidates,
+                     const SparSearchParams& params = {});
+
 }  // namespace sailshape

@@ -1,4 +1,5 @@
-// Finding a spar whose measured place is off by a known amount, beside a sail.
+// Finding a spar whose measured place is off by a known amount, beside a sail; and
+// finding spars nobody gave a place for.
 #include "analysis/spars.hpp"
 
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 #include <random>
 
 #include "analysis/errors.hpp"
+#include "analysis/normals.hpp"
 #include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
@@ -67,6 +69,111 @@ TEST(FitSpar, RejectsASparWithoutAxisLengthOrRadius) {
   SparFitParams bad;
   bad.search_m = 0;
   EXPECT_THROW(fitSpar(c, Spar{"mast", Vec3::Zero(), Vec3::UnitZ(), 2.0, 0.025}, bad), InvalidInput);
+}
+
+// The side of a round spar a scanner at `eye` sees (the half facing it), sampled
+// about `spacing` apart, with σ range noise along the rays.
+void pushVisibleSpar(Cloud& c, const Vec3& base, const Vec3& axis_dir, double length, double radius, const Vec3& eye,
+                     double spacing, std::mt19937& rng) {
+  std::normal_distribution<double> N(0.0, kSigma);
+  const Vec3 a = axis_dir.normalized(), u = a.unitOrthogonal(), v = a.cross(u);
+  for (double t = 0; t <= length; t += spacing)
+    for (double phi = 0; phi < 2 * kPi; phi += spacing / radius) {
+      const Vec3 radial = std::cos(phi) * u + std::sin(phi) * v;
+      const Vec3 p = base + t * a + radius * radial;
+      if (radial.dot(eye - p) <= 0) continue;  // the far side
+      c.points.push_back(p + N(rng) * (p - eye).normalized());
+    }
+}
+
+// A flat deck 4 m x 2 m at z = 0 and a cambered sail-like sheet (5 m radius,
+// more than any spar's), both at 2 cm spacing with σ noise.
+void pushDeckAndSheet(Cloud& c, std::mt19937& rng) {
+  std::normal_distribution<double> N(0.0, kSigma);
+  for (double x = -3; x < 1; x += 0.02)
+    for (double y = -1; y < 1; y += 0.02) c.points.emplace_back(x, y, N(rng));
+  for (double x = -3; x < -0.5; x += 0.02)
+    for (double z = 1; z < 4; z += 0.02) {
+      const double y = 5.0 - std::sqrt(25.0 - (x + 1.75) * (x + 1.75));
+      c.points.emplace_back(x, y + N(rng), z);
+    }
+}
+
+std::vector<uint32_t> everyIndex(const Cloud& c) {
+  std::vector<uint32_t> all(c.size());
+  for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+  return all;
+}
+
+double angleDeg(const Vec3& a, const Vec3& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / kPi;
+}
+
+TEST(FindSpars, FindsALeaningMastAndABoomAmongDeckAndSail) {
+  std::mt19937 rng(11);
+  Cloud c;
+  const Vec3 eye(-1.5, -6.0, 3.0);
+  const Vec3 mast_base(0.1, 0.02, 0.0), mast_dir = Vec3(0.08, 0.03, 1.0).normalized();
+  pushVisibleSpar(c, mast_base, mast_dir, 6.0, 0.07, eye, 0.01, rng);
+  const Vec3 boom_base(-0.05, 0.0, 0.8), boom_dir(-1.0, 0.02, -0.01);
+  pushVisibleSpar(c, boom_base, boom_dir, 3.0, 0.05, eye, 0.01, rng);
+  pushDeckAndSheet(c, rng);
+  const NormalEstimation n = estimateNormals(c);
+  const SparSearch s = findSpars(c, n.normals.normals, everyIndex(c));
+  // The deck and the sheet are no spars: exactly the two.
+  ASSERT_EQ(s.spars.size(), 2u);
+  const SparFit& mast = s.spars[0];
+  const SparFit& boom = s.spars[1];
+  EXPECT_TRUE(mast.found);
+  // Thousands of points each to σ: radius and axis to a quarter of σ, direction to 0.2°.
+  EXPECT_NEAR(mast.spar.radius_m, 0.07, kSigma / 4);
+  EXPECT_NEAR(boom.spar.radius_m, 0.05, kSigma / 4);
+  EXPECT_LT(angleDeg(mast.spar.axis, mast_dir), 0.2);
+  EXPECT_LT(angleDeg(boom.spar.axis, boom_dir), 0.2);
+  auto offAxis = [](const Spar& s, const Vec3& p) {
+    const Vec3 d = p - s.base;
+    return (d - d.dot(s.axis) * s.axis).norm();
+  };
+  EXPECT_LT(offAxis(mast.spar, mast_base + 3.0 * mast_dir), kSigma / 4);
+  EXPECT_LT(offAxis(boom.spar, boom_base + 1.5 * boom_dir.normalized()), kSigma / 4);
+  // It runs as far as its points do (1 cm sampling), not along its whole line.
+  EXPECT_NEAR(mast.spar.length_m, 6.0, 0.03);
+  EXPECT_NEAR(boom.spar.length_m, 3.0, 0.03);
+  EXPECT_GT(mast.support, boom.support);
+  EXPECT_LT(mast.rms_m, kSigma);
+}
+
+TEST(FindSpars, FlatAndGentlyCurvedSurfacesAreNoSpars) {
+  std::mt19937 rng(5);
+  Cloud c;
+  pushDeckAndSheet(c, rng);
+  const NormalEstimation n = estimateNormals(c);
+  const SparSearch s = findSpars(c, n.normals.normals, everyIndex(c));
+  EXPECT_TRUE(s.spars.empty());
+}
+
+TEST(FindSpars, OnlyTheCandidatesAreSearched) {
+  std::mt19937 rng(2);
+  Cloud c;
+  pushVisibleSpar(c, Vec3::Zero(), Vec3::UnitZ(), 3.0, 0.06, Vec3(0, -5, 1.5), 0.01, rng);
+  const NormalEstimation n = estimateNormals(c);
+  EXPECT_TRUE(findSpars(c, n.normals.normals, {}).spars.empty());
+  EXPECT_EQ(findSpars(c, n.normals.normals, everyIndex(c)).spars.size(), 1u);
+}
+
+TEST(FindSpars, RejectsMismatchedNormalsBadIndicesAndBadParameters) {
+  std::mt19937 rng(2);
+  Cloud c;
+  pushVisibleSpar(c, Vec3::Zero(), Vec3::UnitZ(), 1.0, 0.06, Vec3(0, -5, 0.5), 0.02, rng);
+  const std::vector<Vec3> normals(c.size(), Vec3::UnitX());
+  EXPECT_THROW(findSpars(c, std::vector<Vec3>(c.size() - 1, Vec3::UnitX()), everyIndex(c)), InvalidInput);
+  EXPECT_THROW(findSpars(c, normals, {static_cast<uint32_t>(c.size())}), InvalidInput);
+  SparSearchParams bad;
+  bad.max_radius_m = bad.min_radius_m;
+  EXPECT_THROW(findSpars(c, normals, everyIndex(c), bad), InvalidInput);
+  bad = {};
+  bad.sensor_sigma_m = 0;
+  EXPECT_THROW(findSpars(c, normals, everyIndex(c), bad), InvalidInput);
 }
 
 }  // namespace
