@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-
+#include <memory>
 
 #include "analysis/errors.hpp"
 #include "analysis/plane_detection.hpp"
@@ -123,40 +123,69 @@ Cleaning readmitSurfacePoints(const Cloud& cloud, const std::vector<uint32_t>& k
   const size_t k = static_cast<size_t>(p.k_neighbours);
   Cleaning result;
   if (kept.size() > k) {
-    std::vector<Vec3> pts;
-    for (uint32_t i : kept) pts.push_back(cloud.points[i]);
-    double spacing = 0;
-    {
-      const KdTree tree(pts);
-      spacing = medianNeighbourDistance(tree, pts, 2);
-    }
-    const double max_gap = p.max_gap_factor * spacing;
-    std::vector<uint32_t> idx;
-    std::vector<double> d2;
-    // Removed points within reach of the current members and on their surface.
-    auto collect = [&] {
-      std::vector<uint32_t> back;
-      const KdTree tree(pts);  // holds `pts` by reference
-      for (uint32_t i = 0; i < cloud.size(); ++i) {
-        if (in[i]) continue;
-        const Vec3& q = cloud.points[i];
-        tree.nearest(q, k, idx, d2);
-        if (idx.size() < 3 || std::sqrt(d2.front()) > max_gap) continue;
-        const DetectedPlane plane = fitPlane(pts, idx);
-        // Neighbours along a line give no plane to test against.
-        if (plane.width_m < 1e-3 * plane.extent_m) continue;
-        if (std::abs(plane.normal.dot(q) - plane.offset_m) <= p.max_offset_m) back.push_back(i);
+    // One grid over the kept points serves every pass; the points readmitted so far
+    // (few) are searched apart and merged in, which gives the k nearest of the
+    // whole current membership without rebuilding a tree of it each pass.
+    std::vector<Vec3> base;
+    base.reserve(kept.size());
+    for (uint32_t i : kept) base.push_back(cloud.points[i]);
+    const auto grid = gridForNeighbours(base, k);
+    const double max_gap = p.max_gap_factor * medianNeighbourDistance(*grid, base, 2);
+    std::vector<Vec3> pts = base;  // the current members: base, then the readmitted in order
+    std::vector<uint32_t> candidates;
+    for (uint32_t i = 0; i < cloud.size(); ++i)
+      if (!in[i]) candidates.push_back(i);
+    for (int pass = 0; pass < p.passes && !candidates.empty(); ++pass) {
+      const std::vector<Vec3> added(pts.begin() + static_cast<long>(base.size()), pts.end());
+      const std::unique_ptr<KdTree> added_tree = added.empty() ? nullptr : std::make_unique<KdTree>(added);
+      std::vector<char> back(candidates.size(), 0);
+      const long nc = static_cast<long>(candidates.size());
+      // Removed points within reach of the current members and on their surface;
+      // each candidate's answer is written in its own slot (the same every run).
+#pragma omp parallel
+      {
+        std::vector<uint32_t> idx, idx2;
+        std::vector<double> d2, d2b;
+        std::vector<std::pair<double, uint32_t>> merged;
+#pragma omp for schedule(dynamic, 32)
+        for (long c = 0; c < nc; ++c) {
+          const Vec3& q = cloud.points[candidates[static_cast<size_t>(c)]];
+          grid->nearest(q, k, idx, d2);
+          if (added_tree) {
+            added_tree->nearest(q, k, idx2, d2b);
+            merged.clear();
+            for (size_t j = 0; j < idx.size(); ++j) merged.emplace_back(d2[j], idx[j]);
+            for (size_t j = 0; j < idx2.size(); ++j)
+              merged.emplace_back(d2b[j], static_cast<uint32_t>(base.size() + idx2[j]));
+            const size_t m = std::min(k, merged.size());
+            std::partial_sort(merged.begin(), merged.begin() + static_cast<long>(m), merged.end());
+            idx.resize(m);
+            d2.resize(m);
+            for (size_t j = 0; j < m; ++j) {
+              d2[j] = merged[j].first;
+              idx[j] = merged[j].second;
+            }
+          }
+          if (idx.size() < 3 || std::sqrt(d2.front()) > max_gap) continue;
+          const DetectedPlane plane = fitPlane(pts, idx);
+          // Neighbours along a line give no plane to test against.
+          if (plane.width_m < 1e-3 * plane.extent_m) continue;
+          if (std::abs(plane.normal.dot(q) - plane.offset_m) <= p.max_offset_m) back[static_cast<size_t>(c)] = 1;
+        }
       }
-      return back;
-    };
-    for (int pass = 0; pass < p.passes; ++pass) {
-      const std::vector<uint32_t> back = collect();
-      if (back.empty()) break;
       // Admitted after the pass, so the result does not depend on the visiting order.
-      for (uint32_t i : back) {
-        in[i] = 1;
-        pts.push_back(cloud.points[i]);
-      }
+      std::vector<uint32_t> rest;
+      bool any = false;
+      for (size_t c = 0; c < candidates.size(); ++c)
+        if (back[c]) {
+          any = true;
+          in[candidates[c]] = 1;
+          pts.push_back(cloud.points[candidates[c]]);
+        } else {
+          rest.push_back(candidates[c]);
+        }
+      if (!any) break;
+      candidates.swap(rest);
     }
   }
   for (uint32_t i = 0; i < cloud.size(); ++i) (in[i] ? result.kept : result.removed).push_back(i);

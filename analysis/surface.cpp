@@ -44,36 +44,51 @@ std::vector<std::pair<Kernel::Point_2, uint32_t>> projectToScanAngles(const Clou
   return pts;
 }
 
-// Keeps the triangles of the largest edge-connected component.
-size_t keepLargestComponent(std::vector<std::array<uint32_t, 3>>& tris) {
-  struct EdgeKey {
-    uint64_t key;
-    uint32_t tri;
+// Keeps the triangles of the largest edge-connected component (ties: the one
+// holding the lowest triangle). Triangles sharing an edge are found by bucketing
+// each edge under its lower vertex (counting sort: linear in the mesh).
+size_t keepLargestComponent(std::vector<std::array<uint32_t, 3>>& tris, size_t vertices) {
+  struct Half {
+    uint32_t other, tri;
   };
-  std::vector<EdgeKey> edges;
-  edges.reserve(tris.size() * 3);
-  for (uint32_t t = 0; t < tris.size(); ++t)
-    for (int e = 0; e < 3; ++e) {
-      uint64_t a = tris[t][e], b = tris[t][(e + 1) % 3];
-      if (a > b) std::swap(a, b);
-      edges.push_back({(a << 32) | b, t});
-    }
-  std::sort(edges.begin(), edges.end(), [](const EdgeKey& x, const EdgeKey& y) { return x.key < y.key; });
+  std::vector<uint32_t> start(vertices + 1, 0);
+  for (const auto& t : tris)
+    for (int e = 0; e < 3; ++e) ++start[std::min(t[e], t[(e + 1) % 3]) + 1];
+  for (size_t v = 0; v < vertices; ++v) start[v + 1] += start[v];
+  std::vector<Half> halves(start[vertices]);
+  {
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (uint32_t t = 0; t < tris.size(); ++t)
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = tris[t][e], b = tris[t][(e + 1) % 3];
+        halves[fill[std::min(a, b)]++] = {std::max(a, b), t};
+      }
+  }
   std::vector<uint32_t> parent(tris.size());
   std::iota(parent.begin(), parent.end(), 0u);
   auto find = [&](uint32_t x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
-  for (size_t i = 1; i < edges.size(); ++i)
-    if (edges[i].key == edges[i - 1].key) parent[find(edges[i].tri)] = find(edges[i - 1].tri);
+  for (size_t v = 0; v < vertices; ++v)
+    for (uint32_t i = start[v]; i < start[v + 1]; ++i)
+      for (uint32_t j = start[v]; j < i; ++j)
+        if (halves[j].other == halves[i].other) {
+          parent[find(halves[i].tri)] = find(halves[j].tri);
+          break;
+        }
   std::vector<uint32_t> count(tris.size(), 0);
-  for (uint32_t t = 0; t < tris.size(); ++t) ++count[find(t)];
-  const uint32_t best = static_cast<uint32_t>(std::max_element(count.begin(), count.end()) - count.begin());
+  std::vector<uint32_t> root(tris.size());
+  for (uint32_t t = 0; t < tris.size(); ++t) ++count[root[t] = find(t)];
+  // Triangles are visited in index order, so the first root reaching the largest
+  // count strictly is the component holding the lowest triangle among the largest.
+  uint32_t best = root[0];
+  for (uint32_t t = 0; t < tris.size(); ++t)
+    if (count[root[t]] > count[best]) best = root[t];
   std::vector<std::array<uint32_t, 3>> kept;
   kept.reserve(count[best]);
   for (uint32_t t = 0; t < tris.size(); ++t)
-    if (find(t) == best) kept.push_back(tris[t]);
+    if (root[t] == best) kept.push_back(tris[t]);
   const size_t dropped = tris.size() - kept.size();
   tris.swap(kept);
   return dropped;
@@ -144,7 +159,7 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
   if (kept.empty())
     throw AnalysisError("[reconstructSurface] every triangle has an edge longer than max_edge_m = " +
                         std::to_string(max_edge) + " m");
-  if (p.largest_component_only) result.dropped_small_components = keepLargestComponent(kept);
+  if (p.largest_component_only) result.dropped_small_components = keepLargestComponent(kept, cloud.size());
 
   // Compact: mesh vertices are the used input points, in input order.
   std::vector<uint32_t> remap(cloud.size(), std::numeric_limits<uint32_t>::max());

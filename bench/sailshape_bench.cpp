@@ -15,12 +15,14 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <random>
 #include <map>
+#include <string>
 
 #include "analysis/cleaning.hpp"
 #include "analysis/design_compare.hpp"
@@ -212,8 +214,10 @@ void BM_Ours_WholeAnalysis(benchmark::State& state) {
   const Cloud& c = sail(static_cast<size_t>(state.range(0)));
   const SailSurface truth(exampleDesign(SailType::Main));
   double camber = 0, draft = 0, twist = 0, ends = 0;
+  std::map<std::string, double> stage_ms;  // summed over iterations
   for (auto _ : state) {
     const SailAnalysis a = analyzeSail(c);
+    for (const StageReport& r : a.stages) stage_ms[r.name] += 1e3 * r.seconds;
     for (const Section& s : a.sections.sections) {
       const KnownSection k = truth.section(s.fraction);
       camber = std::max(camber, std::abs(s.value.camber_pct - k.camber_pct));
@@ -226,6 +230,12 @@ void BM_Ours_WholeAnalysis(benchmark::State& state) {
   state.counters["err_draft_pct"] = draft;
   state.counters["err_twist_deg"] = twist;
   state.counters["err_entry_exit_deg"] = ends;
+  // Each stage's wall time, ms per run ("statistical outliers" -> "ms_statistical_outliers").
+  for (const auto& [name, ms] : stage_ms) {
+    std::string key = "ms_" + name;
+    std::replace(key.begin(), key.end(), ' ', '_');
+    state.counters[key] = ms / static_cast<double>(state.iterations());
+  }
   finish(state, c.size());
 }
 // The same chain with PCL's stock classes: normals → region growing → SOR →
