@@ -228,6 +228,18 @@ struct PointGrid::Impl {
         }
       }
   }
+  // Calls f(cell) for every occupied cell that may hold a point within radius_m of a
+  // point in cell c: the rings around c, or every cell when those would be more.
+  template <class F>
+  void forCellsWithin(const Eigen::Vector3i& c, double radius_m, F&& f) const {
+    const double rings = std::ceil(radius_m * inv);
+    const size_t cells = cell_start.size() - 1;
+    if (rings > 64 || std::pow(2 * rings + 1, 3) > static_cast<double>(cells)) {
+      for (size_t id = 0; id < cells; ++id) f(id);
+      return;
+    }
+    for (int ring = 0; ring <= static_cast<int>(rings); ++ring) forRing(c, ring, f);
+  }
   // Distance from q (in cell c) to the nearest face of its cell.
   double marginInCell(const Vec3& q, const Eigen::Vector3i& c) const {
     double m = cell;
@@ -278,6 +290,12 @@ PointGrid::PointGrid(const std::vector<Vec3>& points, double cell_m)
 PointGrid::~PointGrid() = default;
 
 double PointGrid::cellSize() const { return impl_->cell; }
+size_t PointGrid::cellCount() const { return impl_->cell_start.size() - 1; }
+const std::vector<uint32_t>& PointGrid::cellStart() const { return impl_->cell_start; }
+const std::vector<uint32_t>& PointGrid::cellPoints() const { return impl_->sorted_index; }
+Vec3 PointGrid::cellCentre(size_t c) const {
+  return impl_->origin + (impl_->cell_coord.at(c).cast<double>() + Vec3::Constant(0.5)) * impl_->cell;
+}
 
 void PointGrid::nearest(const Vec3& q, size_t k, std::vector<uint32_t>& indices, std::vector<double>& dist2) const {
   k = std::min(k, impl_->pts.size());
@@ -304,7 +322,7 @@ void PointGrid::withinRadius(const Vec3& q, double radius_m, std::vector<uint32_
   if (!(radius_m >= 0)) return;
   const double r2 = radius_m * radius_m;
   const Impl& g = *impl_;
-  auto add = [&](size_t cell_id) {
+  g.forCellsWithin(g.coordOf(q), radius_m, [&](size_t cell_id) {
     for (uint32_t j = g.cell_start[cell_id]; j < g.cell_start[cell_id + 1]; ++j) {
       const double d = (g.sorted[j] - q).squaredNorm();
       if (d <= r2) {
@@ -313,15 +331,20 @@ void PointGrid::withinRadius(const Vec3& q, double radius_m, std::vector<uint32_
         if (points) points->push_back(g.sorted[j]);
       }
     }
-  };
-  const double rings = std::ceil(radius_m * g.inv);
-  const size_t cells = g.cell_start.size() - 1;
-  if (rings > 64 || std::pow(2 * rings + 1, 3) > static_cast<double>(cells)) {
-    for (size_t c = 0; c < cells; ++c) add(c);
-    return;
-  }
-  const Eigen::Vector3i c = g.coordOf(q);
-  for (int ring = 0; ring <= static_cast<int>(rings); ++ring) g.forRing(c, ring, add);
+  });
+}
+
+void PointGrid::cellNeighbourhood(size_t c, double radius_m, std::vector<uint32_t>& indices,
+                                  std::vector<Vec3>& points) const {
+  indices.clear();
+  points.clear();
+  if (!(radius_m >= 0)) return;
+  const Impl& g = *impl_;
+  g.forCellsWithin(g.cell_coord.at(c), radius_m, [&](size_t cell_id) {
+    indices.insert(indices.end(), g.sorted_index.begin() + g.cell_start[cell_id],
+                   g.sorted_index.begin() + g.cell_start[cell_id + 1]);
+    points.insert(points.end(), g.sorted.begin() + g.cell_start[cell_id], g.sorted.begin() + g.cell_start[cell_id + 1]);
+  });
 }
 
 void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progress) const {
@@ -378,9 +401,14 @@ void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progr
           const double sure2 = everything ? std::numeric_limits<double>::infinity() : sure * sure;
           bool done = false;
           for (double limit2 : {std::min(sure2, 0.7 * g.cell * g.cell), sure2}) {
-            cand.clear();
-            for (size_t j = 0; j < m; ++j)
-              if (dd[j] <= limit2) cand.emplace_back(dd[j], near_idx[j]);
+            // Every candidate written, kept when within the limit: no branch to mispredict.
+            cand.resize(m);
+            size_t within = 0;
+            for (size_t j = 0; j < m; ++j) {
+              cand[within] = {dd[j], near_idx[j]};
+              within += dd[j] <= limit2 ? 1 : 0;
+            }
+            cand.resize(within);
             if (cand.size() >= k) {
               keepNearest(cand, k);
               done = true;
@@ -399,17 +427,31 @@ void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progr
 
 std::unique_ptr<PointGrid> gridForNeighbours(const std::vector<Vec3>& points, size_t k) {
   k = std::max<size_t>(1, k);
-  // First guess: the points spread over the bounding box's largest face.
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const Vec3& p : points) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
   if (points.size() < 2) return std::make_unique<PointGrid>(points, 1.0);
-  Vec3 e = hi - lo;
-  std::sort(e.data(), e.data() + 3);
-  const double area = std::max({e[2] * e[1], 1e-6 * e[2] * e[2], 1e-12});
-  const double density = static_cast<double>(points.size()) / area;
+  // First guess: the points spread over the part of the bounding box's largest
+  // face they cover, counted in bins holding about 16 points each if the face
+  // were full (a triangular sail covers about half its box; a wrong guess costs a
+  // second grid, not exactness).
+  int axis[3] = {0, 1, 2};
+  const Vec3 e = hi - lo;
+  std::sort(axis, axis + 3, [&](int a, int b) { return e[a] > e[b]; });
+  const int u = axis[0], v = axis[1];
+  const double face = std::max({e[u] * e[v], 1e-6 * e[u] * e[u], 1e-12});
+  const int bins = static_cast<int>(std::clamp(std::sqrt(static_cast<double>(points.size()) / 16.0), 1.0, 256.0));
+  std::vector<char> occupied(static_cast<size_t>(bins) * static_cast<size_t>(bins), 0);
+  auto bin = [&](double x, double lo_x, double size) {
+    return std::clamp(static_cast<int>((x - lo_x) / std::max(size, 1e-12) * bins), 0, bins - 1);
+  };
+  for (const Vec3& p : points) occupied[static_cast<size_t>(bin(p[u], lo[u], e[u]) * bins + bin(p[v], lo[v], e[v]))] = 1;
+  size_t count = 0;
+  for (char o : occupied) count += o;
+  const double area = face * static_cast<double>(count) / static_cast<double>(occupied.size());
+  const double density = static_cast<double>(points.size()) / std::max(area, 1e-12);
   const double guess = 1.5 * std::sqrt(static_cast<double>(k) / (M_PI * density));
   auto grid = std::make_unique<PointGrid>(points, guess);
   const double median = medianNeighbourDistance(*grid, points, std::min(k, points.size()), 64);

@@ -67,6 +67,19 @@ class PointGrid {
   // nearestNeighbours() lays it out.
   void fillTable(NeighbourTable& table, size_t k, const Progress& progress) const;
 
+  // The grid's occupied cells, in its storage (Morton) order: cell c holds the
+  // points cellPoints()[cellStart()[c] .. cellStart()[c + 1]) (indices into
+  // `points`), all within half a cell width of cellCentre(c) along each axis. A batch
+  // of queries can go cell by cell and share what it gathers around each cell.
+  size_t cellCount() const;
+  const std::vector<uint32_t>& cellStart() const;
+  const std::vector<uint32_t>& cellPoints() const;
+  Vec3 cellCentre(size_t c) const;
+  // Every point of every cell that withinRadius(q, radius_m) reads for a query q in
+  // cell c, in the order it reads them, with their coordinates: filtering these by
+  // distance gives that call's answer, in its order, without searching the cells again.
+  void cellNeighbourhood(size_t c, double radius_m, std::vector<uint32_t>& indices, std::vector<Vec3>& points) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -7,6 +7,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "analysis/errors.hpp"
@@ -261,6 +262,59 @@ TEST(PointGrid, WithinRadiusFindsExactlyThePointsInTheBall) {
   g.withinRadius(pts[10], 0.07, idx, d2);
   g.withinRadius(pts[10], 0.07, again, d2);
   EXPECT_EQ(idx, again);
+}
+
+TEST(PointGrid, CellsHoldEveryPointOnceNearTheirCentres) {
+  const std::vector<Vec3> pts = sheetWithStrays(3000, 25);
+  const double cell = 0.05;
+  const PointGrid g(pts, cell);
+  const std::vector<uint32_t>& start = g.cellStart();
+  const std::vector<uint32_t>& held = g.cellPoints();
+  ASSERT_EQ(start.size(), g.cellCount() + 1);
+  EXPECT_EQ(start.front(), 0u);
+  EXPECT_EQ(start.back(), pts.size());
+  std::vector<int> seen(pts.size(), 0);
+  for (size_t c = 0; c < g.cellCount(); ++c) {
+    EXPECT_LT(start[c], start[c + 1]) << "cell " << c << " is listed but empty";
+    const Vec3 centre = g.cellCentre(c);
+    for (uint32_t s = start[c]; s < start[c + 1]; ++s) {
+      ASSERT_LT(held[s], pts.size());
+      ++seen[held[s]];
+      EXPECT_LE((pts[held[s]] - centre).cwiseAbs().maxCoeff(), 0.5 * cell + 1e-12) << "point " << held[s];
+    }
+  }
+  for (size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(seen[i], 1) << "point " << i;
+  // No two cells share a centre.
+  std::set<std::tuple<double, double, double>> centres;
+  for (size_t c = 0; c < g.cellCount(); ++c) {
+    const Vec3 m = g.cellCentre(c);
+    centres.emplace(m.x(), m.y(), m.z());
+  }
+  EXPECT_EQ(centres.size(), g.cellCount());
+}
+
+TEST(PointGrid, ACellsNeighbourhoodHoldsWhatWithinRadiusReadsInItsOrder) {
+  const std::vector<Vec3> pts = sheetWithStrays(3000, 26);
+  const PointGrid g(pts, 0.05);
+  std::vector<uint32_t> near, idx, expected;
+  std::vector<Vec3> near_pts;
+  std::vector<double> d2;
+  // Radii within one ring, within several, and wide enough to read every cell.
+  for (double r : {0.03, 0.12, 10.0})
+    for (size_t c = 0; c < g.cellCount(); c += 7) {
+      g.cellNeighbourhood(c, r, near, near_pts);
+      ASSERT_EQ(near.size(), near_pts.size());
+      for (size_t j = 0; j < near.size(); ++j) ASSERT_EQ(near_pts[j], pts[near[j]]);
+      // Filtered by distance, it is withinRadius's answer for each point of the cell, in its order.
+      for (uint32_t s = g.cellStart()[c]; s < g.cellStart()[c + 1]; ++s) {
+        const Vec3& q = pts[g.cellPoints()[s]];
+        g.withinRadius(q, r, idx, d2);
+        expected.clear();
+        for (size_t j = 0; j < near.size(); ++j)
+          if ((near_pts[j] - q).squaredNorm() <= r * r) expected.push_back(near[j]);
+        EXPECT_EQ(idx, expected) << "radius " << r << " cell " << c;
+      }
+    }
 }
 
 TEST(PointGrid, TableMatchesTheKdTreeOnANoisySheet) {
