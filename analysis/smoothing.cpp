@@ -214,8 +214,34 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
     // made again from the 2k nearest, which reach about as far into the surface
     // as an inner neighbourhood spans across it.
     const size_t k_edge = std::min(2 * k, pts.size());
-    auto fitAt = [&](const Vec3& at, Buffers& b, float* used_radius) {
-      grid.withinRadius(at, reach, b.cand, b.cand_d2, &b.cand_pts);
+    // The points every query in one grid cell reads (PointGrid::cellNeighbourhood),
+    // gathered once for all of that cell's fits.
+    struct Gathered {
+      std::vector<uint32_t> index;
+      std::vector<Vec3> points;
+    };
+    const double reach2 = reach * reach;
+    auto fitAt = [&](const Vec3& at, Buffers& b, float* used_radius, const Gathered* near) {
+      if (near) {
+        // The same candidates, in the same order, as grid.withinRadius(at, reach).
+        const size_t m = near->index.size();
+        b.cand.resize(m);
+        b.cand_d2.resize(m);
+        b.cand_pts.resize(m);
+        size_t kept = 0;  // written every time, kept when within reach: no branch to mispredict
+        for (size_t j = 0; j < m; ++j) {
+          const double d = (near->points[j] - at).squaredNorm();
+          b.cand[kept] = near->index[j];
+          b.cand_d2[kept] = d;
+          b.cand_pts[kept] = near->points[j];
+          kept += d <= reach2 ? 1 : 0;
+        }
+        b.cand.resize(kept);
+        b.cand_d2.resize(kept);
+        b.cand_pts.resize(kept);
+      } else {
+        grid.withinRadius(at, reach, b.cand, b.cand_d2, &b.cand_pts);
+      }
       b.row_pts.clear();
       b.row_d2.clear();
       for (size_t j = 0; j < b.cand.size(); ++j)
@@ -272,19 +298,39 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
         Buffers b;
 #pragma omp for schedule(dynamic, 64)
         for (long i = 0; i < n; ++i)
-          result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i]).project(pts[i]);
+          result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i], nullptr).project(pts[i]);
       }
     } else {
       const std::vector<uint32_t> anchors = pickAnchors(pts, std::max(1e-6, p.anchor_ratio * radius));
-      const long na = static_cast<long>(anchors.size());
       std::vector<LocalSurface> surfaces(anchors.size());
       std::vector<float> anchor_radius(anchors.size());
+      // Anchors grouped by grid cell (counting sort), fitted cell by cell.
+      const size_t cells = grid.cellCount();
+      std::vector<uint32_t> cell_of(pts.size());
+      for (size_t c = 0; c < cells; ++c)
+        for (uint32_t slot = grid.cellStart()[c]; slot < grid.cellStart()[c + 1]; ++slot)
+          cell_of[grid.cellPoints()[slot]] = static_cast<uint32_t>(c);
+      std::vector<uint32_t> anchor_start(cells + 1, 0), by_cell(anchors.size());
+      for (uint32_t i : anchors) ++anchor_start[cell_of[i] + 1];
+      for (size_t c = 0; c < cells; ++c) anchor_start[c + 1] += anchor_start[c];
+      {
+        std::vector<uint32_t> fill(anchor_start.begin(), anchor_start.end() - 1);
+        for (uint32_t a = 0; a < anchors.size(); ++a) by_cell[fill[cell_of[anchors[a]]]++] = a;
+      }
 #pragma omp parallel
       {
         Buffers b;
-#pragma omp for schedule(dynamic, 64)
-        for (long a = 0; a < na; ++a)
-          surfaces[static_cast<size_t>(a)] = fitAt(pts[anchors[static_cast<size_t>(a)]], b, &anchor_radius[a]);
+        Gathered near;
+#pragma omp for schedule(dynamic, 4)
+        for (long c = 0; c < static_cast<long>(cells); ++c) {
+          const size_t cs = static_cast<size_t>(c);
+          if (anchor_start[cs] == anchor_start[cs + 1]) continue;
+          grid.cellNeighbourhood(cs, reach, near.index, near.points);
+          for (uint32_t s = anchor_start[cs]; s < anchor_start[cs + 1]; ++s) {
+            const uint32_t a = by_cell[s];
+            surfaces[a] = fitAt(pts[anchors[a]], b, &anchor_radius[a], &near);
+          }
+        }
       }
       progress("smoothing", 0.5);
       // An anchor inside the surface (its neighbourhood all around it, within the
@@ -296,36 +342,74 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
         inside[a] = surfaces[a].centroid_offset <= kInsideCentroidOffset && anchor_radius[a] <= kInsideRadius * radius;
       std::vector<Vec3> anchor_pts(anchors.size());
       for (size_t a = 0; a < anchors.size(); ++a) anchor_pts[a] = pts[anchors[a]];
-      const PointGrid anchor_grid(anchor_pts, std::max(1e-6, p.anchor_ratio * radius));
+      const double spacing = std::max(1e-6, p.anchor_ratio * radius);
+      const PointGrid anchor_grid(anchor_pts, spacing);
       const size_t blend = std::min<size_t>(4, anchors.size());
       std::vector<char> own_fit(pts.size(), 0);
+      // The points go cell by cell of `grid`: a cell's points share the anchors
+      // within `sure` of any of them, gathered once. A point whose `blend`-th
+      // nearest of those lies within `sure` has its nearest anchors among them
+      // (the same ones and order a search gives: ties to the lower index);
+      // otherwise (far from every anchor) it searches.
+      const double sure = 2.0 * spacing;
+      const double gather = (0.5 * std::sqrt(3.0) * grid.cellSize() + sure) * (1 + 1e-9);
+      const std::vector<uint32_t>& cell_start = grid.cellStart();
+      const std::vector<uint32_t>& cell_points = grid.cellPoints();
 #pragma omp parallel
       {
         Buffers b;
-        std::vector<uint32_t> near;
-        std::vector<double> nd2;
-#pragma omp for schedule(dynamic, 256)
-        for (long i = 0; i < n; ++i) {
-          anchor_grid.nearest(pts[i], blend, near, nd2);
-          bool all_inside = true;
-          for (uint32_t a : near) all_inside = all_inside && inside[a];
-          if (!all_inside) {
-            own_fit[i] = 1;
-            result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i]).project(pts[i]);
-            continue;
+        Gathered near_points;
+        std::vector<uint32_t> near, shared;
+        std::vector<double> nd2, shared_d2;
+        std::pair<double, uint32_t> top[4];  // blend <= 4
+#pragma omp for schedule(dynamic, 4)
+        for (long c = 0; c < static_cast<long>(cells); ++c) {
+          const size_t cs = static_cast<size_t>(c);
+          bool gathered = false;  // near_points holds this cell's neighbourhood
+          anchor_grid.withinRadius(grid.cellCentre(cs), gather, shared, shared_d2);
+          for (uint32_t slot = cell_start[cs]; slot < cell_start[cs + 1]; ++slot) {
+            const uint32_t i = cell_points[slot];
+            // The `blend` nearest gathered anchors by (distance², index), as a search orders them.
+            size_t have = 0;
+            for (uint32_t a : shared) {
+              const std::pair<double, uint32_t> cand((anchor_pts[a] - pts[i]).squaredNorm(), a);
+              if (have == blend && !(cand < top[blend - 1])) continue;
+              size_t j = have < blend ? have++ : blend - 1;
+              for (; j > 0 && cand < top[j - 1]; --j) top[j] = top[j - 1];
+              top[j] = cand;
+            }
+            if (have == blend && top[blend - 1].first <= sure * sure) {
+              near.resize(blend);
+              nd2.resize(blend);
+              for (size_t j = 0; j < blend; ++j) {
+                nd2[j] = top[j].first;
+                near[j] = top[j].second;
+              }
+            } else {
+              anchor_grid.nearest(pts[i], blend, near, nd2);
+            }
+            bool all_inside = true;
+            for (uint32_t a : near) all_inside = all_inside && inside[a];
+            if (!all_inside) {
+              own_fit[i] = 1;
+              if (!gathered) grid.cellNeighbourhood(cs, reach, near_points.index, near_points.points);
+              gathered = true;
+              result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i], &near_points).project(pts[i]);
+              continue;
+            }
+            // A distance-weighted blend of the nearest anchors' projections.
+            const double h2 = std::max(1e-12, nd2.back() * 2.0);
+            Vec3 sum = Vec3::Zero();
+            double wsum = 0, rsum = 0;
+            for (size_t j = 0; j < near.size(); ++j) {
+              const double w = std::exp(-nd2[j] / h2);
+              sum += w * surfaces[near[j]].project(pts[i]);
+              rsum += w * anchor_radius[near[j]];
+              wsum += w;
+            }
+            result.cloud.points[i] = sum / wsum;
+            point_radius[i] = static_cast<float>(rsum / wsum);
           }
-          // A distance-weighted blend of the nearest anchors' projections.
-          const double h2 = std::max(1e-12, nd2.back() * 2.0);
-          Vec3 sum = Vec3::Zero();
-          double wsum = 0, rsum = 0;
-          for (size_t j = 0; j < near.size(); ++j) {
-            const double w = std::exp(-nd2[j] / h2);
-            sum += w * surfaces[near[j]].project(pts[i]);
-            rsum += w * anchor_radius[near[j]];
-            wsum += w;
-          }
-          result.cloud.points[i] = sum / wsum;
-          point_radius[i] = static_cast<float>(rsum / wsum);
         }
       }
       fitted = anchors.size();
