@@ -11,6 +11,7 @@
 #include "analysis/neighbours.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 namespace sailshape {
 namespace {
@@ -357,6 +358,46 @@ Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const KdTree& tree, double 
   return m.point + (xsum / wsum) * m.outward;
 }
 
+// The edges' crossing is placed well within the sail's surface but not in depth:
+// there each edge's corner curve extrapolates its own bend (a foot leaves the
+// tack at the entry angle and curves away), and a jib's tack came out 3 cm off
+// the surface. The corner lies on the surface: the quadratic height field of the
+// mesh vertices around it (at least 40 of them, within 10-160 boundary
+// spacings), which reaches the few spacings beyond the samples to the corner far
+// better, and the corner moves onto it along its normal.
+Vec3 ontoSurface(const Vec3& c, const Mesh& mesh, const KdTree& tree, double spacing) {
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  double radius = 10.0 * spacing;
+  for (int i = 0; i < 5; ++i, radius *= 2.0) {
+    tree.withinRadius(c, radius, idx, d2);
+    if (idx.size() >= 40) break;
+  }
+  if (idx.size() < 40) return c;
+  Vec3 mean = Vec3::Zero();
+  for (uint32_t v : idx) mean += mesh.vertices[v];
+  mean /= static_cast<double>(idx.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (uint32_t v : idx) {
+    const Vec3 d = mesh.vertices[v] - mean;
+    cov += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const Vec3 n = eig.eigenvectors().col(0), eu = eig.eigenvectors().col(2), ev = n.cross(eu);
+  // Height over (u, v) about the corner, in units of the radius.
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(idx.size()), 6);
+  Eigen::VectorXd z(static_cast<Eigen::Index>(idx.size()));
+  for (size_t i = 0; i < idx.size(); ++i) {
+    const Vec3 d = mesh.vertices[idx[i]] - c;
+    const double u = d.dot(eu) / radius, v = d.dot(ev) / radius;
+    A.row(static_cast<Eigen::Index>(i)) << 1, u, v, u * u, u * v, v * v;
+    z[static_cast<Eigen::Index>(i)] = d.dot(n);
+  }
+  const Eigen::VectorXd h = A.colPivHouseholderQr().solve(z);
+  if (!h.allFinite()) return c;
+  return c + h[0] * n;
+}
+
 // The edge from corner to corner: the fitted curve between the excluded ends.
 std::vector<Vec3> edgePolyline(const Edge& e, const Vec3& first, const Vec3& last, double step) {
   std::vector<Vec3> out{first};
@@ -537,7 +578,8 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   const double density = static_cast<double>(mesh.vertices.size()) / std::max(1e-12, meshArea(mesh));
   const double reach = std::max(0.05 * total, 10.0 * sp);
   auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start) {
-    return placeCorner(meetEdges(a, a_start, b, b_start, sp), mesh, tree, density, reach);
+    const Vec3 c = placeCorner(meetEdges(a, a_start, b, b_start, sp), mesh, tree, density, reach);
+    return ontoSurface(c, mesh, tree, sp);
   };
   out.tack = corner(luff, true, foot, true);
   out.clew = corner(foot, false, leech, true);

@@ -133,6 +133,30 @@ TEST(Pipeline, NoisyMainsailRecoversKnownSectionsWithinTheNoiseTargets) {
   EXPECT_LT((a.outline.head - truth.head()).norm(), 0.03);
 }
 
+TEST(Pipeline, NoisyJibMeetsTheTargetsWithItsTackOnTheSurface) {
+  // A jib's foot leaves the tack at the entry angle and curves away in depth;
+  // the edges' crossing alone put the tack 3-4 cm off the sail's surface.
+  const SailDesign design = exampleDesign(SailType::Jib);
+  ScanSimulation sim;
+  sim.points = 40000;
+  sim.noise_sigma_m = 0.004;
+  sim.seed = 2;
+  const SailAnalysis a = analyzeSail(sampleSail(design, sim));
+  const SailSurface truth(design);
+  ASSERT_EQ(a.sections.sections.size(), 3u);
+  for (const Section& s : a.sections.sections) {
+    const KnownSection k = truth.section(s.fraction);
+    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, 0.3);
+    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, 2.0);
+    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, 0.3);
+    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, 2.5);
+    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, 2.5);
+  }
+  EXPECT_LT((a.outline.tack - truth.tack()).norm(), 0.03);
+  EXPECT_LT((a.outline.clew - truth.clew()).norm(), 0.03);
+  EXPECT_LT((a.outline.head - truth.head()).norm(), 0.03);
+}
+
 TEST(Pipeline, DenseNoisyMainsailKeepsItsEndAnglesWithinTheNoiseTargets) {
   // Five times denser than above: more points must not make it worse. The MLS
   // neighbourhood (a fixed count) then spans a smaller patch, and an edge
