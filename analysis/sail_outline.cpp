@@ -3,9 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
-#include <unordered_map>
-#include <unordered_set>
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
@@ -24,54 +21,97 @@ std::string fmt(double v, int digits = 3) {
   return buf;
 }
 
-// The longest closed loop of boundary edges (edges used by exactly one triangle).
+// The longest closed loop of boundary edges: directed edges a→b used by exactly
+// one triangle whose reverse b→a no triangle uses. Edges are bucketed by their
+// lower vertex (counting sort, linear in the mesh) instead of hashed: the mesh
+// of a 200,000-point scan has 1.2 million directed edges.
 std::vector<uint32_t> outerBoundaryLoop(const Mesh& mesh) {
-  std::unordered_map<uint64_t, int> directed;
-  directed.reserve(mesh.triangles.size() * 3);
-  auto key = [](uint64_t a, uint64_t b) { return (a << 32) | b; };
+  const size_t nv = mesh.vertices.size();
+  // Each undirected edge under its lower vertex: the other vertex and whether the
+  // triangle runs lower→higher.
+  struct Half {
+    uint32_t other;
+    bool up;
+  };
+  std::vector<uint32_t> start(nv + 1, 0);
   for (const auto& t : mesh.triangles)
-    for (int e = 0; e < 3; ++e) ++directed[key(t[e], t[(e + 1) % 3])];
-  std::unordered_multimap<uint32_t, uint32_t> next;
-  for (const auto& [k, count] : directed) {
-    const uint32_t a = static_cast<uint32_t>(k >> 32), b = static_cast<uint32_t>(k & 0xffffffffu);
-    if (count == 1 && !directed.count(key(b, a))) next.emplace(a, b);
-  }
-  if (next.empty()) throw AnalysisError("[extractOutline] the mesh has no boundary edge (closed surface?)");
-  std::unordered_set<uint64_t> used;
-  std::vector<uint32_t> best;
-  double best_len = -1;
-  for (const auto& [start, first] : next) {
-    if (used.count(key(start, first))) continue;
-    std::vector<uint32_t> loop{start};
-    uint32_t cur = start, nxt = first;
-    bool closed = false;
-    while (true) {
-      used.insert(key(cur, nxt));
-      if (nxt == start) {
-        closed = true;
-        break;
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = t[e], b = t[(e + 1) % 3];
+      if (std::max(a, b) >= nv)
+        throw InvalidInput("[extractOutline] a triangle uses vertex " + std::to_string(std::max(a, b)) +
+                           " of a mesh with " + std::to_string(nv) + " vertices");
+      if (a != b) ++start[std::min(a, b) + 1];  // a self-edge is its own reverse: never a boundary
+    }
+  for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+  std::vector<Half> halves(start[nv]);
+  {
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (const auto& t : mesh.triangles)
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = t[e], b = t[(e + 1) % 3];
+        if (a == b) continue;
+        halves[fill[std::min(a, b)]++] = {std::max(a, b), a < b};
       }
-      loop.push_back(nxt);
-      cur = nxt;
-      auto range = next.equal_range(cur);
-      bool found = false;
-      for (auto it = range.first; it != range.second; ++it)
-        if (!used.count(key(cur, it->second))) {
-          nxt = it->second;
-          found = true;
+  }
+  // Boundary edges (from, to), in the order of their lower vertex.
+  std::vector<std::pair<uint32_t, uint32_t>> boundary;
+  for (uint32_t v = 0; v < nv; ++v) {
+    const Half* h = halves.data() + start[v];
+    const size_t m = start[v + 1] - start[v];
+    for (size_t i = 0; i < m; ++i) {
+      bool seen = false;  // this vertex pair already counted at an earlier slot
+      for (size_t j = 0; j < i && !seen; ++j) seen = h[j].other == h[i].other;
+      if (seen) continue;
+      int up = 0, down = 0;
+      for (size_t j = i; j < m; ++j)
+        if (h[j].other == h[i].other) ++(h[j].up ? up : down);
+      if (up == 1 && down == 0) boundary.emplace_back(v, h[i].other);
+      if (down == 1 && up == 0) boundary.emplace_back(h[i].other, v);
+    }
+  }
+  if (boundary.empty()) throw AnalysisError("[extractOutline] the mesh has no boundary edge (closed surface?)");
+  // Outgoing boundary edges of each vertex: out_to[out_start[v] .. out_start[v + 1]).
+  std::vector<uint32_t> out_start(nv + 1, 0), out_to(boundary.size());
+  for (const auto& [a, b] : boundary) ++out_start[a + 1];
+  for (size_t v = 0; v < nv; ++v) out_start[v + 1] += out_start[v];
+  {
+    std::vector<uint32_t> fill(out_start.begin(), out_start.end() - 1);
+    for (const auto& [a, b] : boundary) out_to[fill[a]++] = b;
+  }
+  std::vector<char> used(boundary.size(), 0);
+  std::vector<uint32_t> best, loop;
+  double best_len = -1;
+  for (uint32_t from = 0; from < nv; ++from)
+    for (uint32_t first_edge = out_start[from]; first_edge < out_start[from + 1]; ++first_edge) {
+      if (used[first_edge]) continue;
+      loop.assign(1, from);
+      uint32_t edge = first_edge;
+      bool closed = false;
+      while (true) {
+        used[edge] = 1;
+        const uint32_t nxt = out_to[edge];
+        if (nxt == from) {
+          closed = true;
           break;
         }
-      if (!found || loop.size() > next.size()) break;
+        loop.push_back(nxt);
+        bool found = false;
+        for (uint32_t e = out_start[nxt]; e < out_start[nxt + 1] && !found; ++e)
+          if (!used[e]) {
+            edge = e;
+            found = true;
+          }
+        if (!found || loop.size() > boundary.size()) break;
+      }
+      if (!closed || loop.size() < 3) continue;
+      double len = 0;
+      for (size_t i = 0; i < loop.size(); ++i)
+        len += (mesh.vertices[loop[i]] - mesh.vertices[loop[(i + 1) % loop.size()]]).norm();
+      if (len > best_len) {
+        best_len = len;
+        best = loop;
+      }
     }
-    if (!closed || loop.size() < 3) continue;
-    double len = 0;
-    for (size_t i = 0; i < loop.size(); ++i)
-      len += (mesh.vertices[loop[i]] - mesh.vertices[loop[(i + 1) % loop.size()]]).norm();
-    if (len > best_len) {
-      best_len = len;
-      best = loop;
-    }
-  }
   if (best.empty()) throw AnalysisError("[extractOutline] the mesh boundary does not form a closed loop");
   return best;
 }
@@ -152,7 +192,7 @@ struct Edge {
 // [0, ∞), so within the strip o ≤ D of the found edge (offset o from it,
 // positive inwards) they are uniform on [−δ, D] and δ = D − 2·mean(o).
 // The edge's points are moved out by δ and the curve is fitted again.
-void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const KdTree& tree, double spacing) {
+void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const PointGrid& tree, double spacing) {
   e.length = e.s.back();
   e.exclude = std::max(0.03 * e.length, 6.0 * spacing);
   std::vector<size_t> inner;
@@ -333,7 +373,7 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
 // length L beyond it, sampled at ρ points/m², stays empty with probability
 // exp(−ρ·L²·tan(angle/2)) (the wedge's area). The corner is placed at the mean
 // of the crossing's Gaussian times that probability, for L ≥ 0.
-Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const KdTree& tree, double density, double reach) {
+Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, double density, double reach) {
   if (m.outward.isZero() || !(density > 0) || !(m.sigma_along_m > 0)) return m.point;
   std::vector<uint32_t> idx;
   std::vector<double> d2;
@@ -365,7 +405,7 @@ Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const KdTree& tree, double 
 // mesh vertices around it (at least 40 of them, within 10-160 boundary
 // spacings), which reaches the few spacings beyond the samples to the corner far
 // better, and the corner moves onto it along its normal.
-Vec3 ontoSurface(const Vec3& c, const Mesh& mesh, const KdTree& tree, double spacing) {
+Vec3 ontoSurface(const Vec3& c, const Mesh& mesh, const PointGrid& tree, double spacing) {
   std::vector<uint32_t> idx;
   std::vector<double> d2;
   double radius = 10.0 * spacing;
@@ -561,7 +601,8 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   // Fit each edge, move it out to where the surface really ends, and place the
   // corners where neighbouring edges meet (a sharp corner itself is never sampled).
   const std::vector<Vec3> normals = vertexNormals(mesh);
-  const KdTree tree(mesh.vertices);
+  // Cells about three boundary spacings wide: the 24 nearest vertices of a boundary point lie within two or so.
+  const PointGrid tree(mesh.vertices, 3.0 * std::max(out.boundary_spacing_m, 1e-6));
   auto makeEdge = [&](size_t from, size_t to) {
     Edge e;
     e.points = edge(from, to);
@@ -575,7 +616,8 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   Edge top;
   if (out.has_peak) top = makeEdge(head, peak);
   const double sp = out.boundary_spacing_m;
-  const double density = static_cast<double>(mesh.vertices.size()) / std::max(1e-12, meshArea(mesh));
+  const double mesh_area = meshArea(mesh);
+  const double density = static_cast<double>(mesh.vertices.size()) / std::max(1e-12, mesh_area);
   const double reach = std::max(0.05 * total, 10.0 * sp);
   auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start) {
     const Vec3 c = placeCorner(meetEdges(a, a_start, b, b_start, sp), mesh, tree, density, reach);
@@ -601,7 +643,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   out.top_length_m = polylineLength(out.top);
   double area_outside = luff.recess * out.luff_length_m + foot.recess * out.foot_length_m +
                         leech.recess * out.leech_length_m + top.recess * out.top_length_m;
-  out.area_m2 = meshArea(mesh) + area_outside;
+  out.area_m2 = mesh_area + area_outside;
 
   if (!p.design_lengths_m.empty()) {
     const char* names[3] = {"luff", "leech", "foot"};
