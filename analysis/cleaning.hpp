@@ -52,7 +52,11 @@ Cleaning removeRadiusOutliers(const Cloud& cloud, const NeighbourTable& table, c
 struct ReadmitParams {
   int k_neighbours = 12;
   double max_offset_m = 0.0;     // must be > 0 here; in AnalysisParams 0 means 3 × sensor σ
-  double max_gap_factor = 6.0;
+  // The last sample of a narrow tip stands out alone: a wedge of angle θ sampled at
+  // ρ points/m² stays empty for about 1/√(ρ·tan(θ/2)), 2.4 spacings at a 20° head
+  // and 3.4 at 10°, and ten spacings take in about three times that. (At six, a
+  // main's head sample 7 cm beyond the rest stayed out and the head came 2.5 cm low.)
+  double max_gap_factor = 10.0;
   int passes = 4;
 };
 // `kept` indexes `cloud` (ascending); the result's kept/removed index `cloud` too.
