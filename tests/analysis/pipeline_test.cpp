@@ -13,6 +13,24 @@
 namespace sailshape {
 namespace {
 
+// Issue 2's targets under 4 mm noise at sections 1/4, 1/2, 3/4: camber 0.3 % of
+// chord, draft 2 %, twist 0.3°, entry/exit 2.5°; corners within 3 cm.
+void expectNoisyTargets(const SailAnalysis& a, const SailDesign& design) {
+  const SailSurface truth(design);
+  ASSERT_EQ(a.sections.sections.size(), 3u);
+  for (const Section& s : a.sections.sections) {
+    const KnownSection k = truth.section(s.fraction);
+    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, 0.3) << "section " << s.fraction;
+    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, 2.0) << "section " << s.fraction;
+    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, 0.3) << "section " << s.fraction;
+    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, 2.5) << "section " << s.fraction;
+    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, 2.5) << "section " << s.fraction;
+  }
+  EXPECT_LT((a.outline.tack - truth.tack()).norm(), 0.03);
+  EXPECT_LT((a.outline.clew - truth.clew()).norm(), 0.03);
+  EXPECT_LT((a.outline.head - truth.head()).norm(), 0.03);
+}
+
 struct Tolerance {
   double camber_pct, draft_pct, twist_deg, end_deg, corner_m;
 };
@@ -142,19 +160,7 @@ TEST(Pipeline, NoisyJibMeetsTheTargetsWithItsTackOnTheSurface) {
   sim.noise_sigma_m = 0.004;
   sim.seed = 2;
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
-  const SailSurface truth(design);
-  ASSERT_EQ(a.sections.sections.size(), 3u);
-  for (const Section& s : a.sections.sections) {
-    const KnownSection k = truth.section(s.fraction);
-    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, 0.3);
-    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, 2.0);
-    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, 0.3);
-    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, 2.5);
-    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, 2.5);
-  }
-  EXPECT_LT((a.outline.tack - truth.tack()).norm(), 0.03);
-  EXPECT_LT((a.outline.clew - truth.clew()).norm(), 0.03);
-  EXPECT_LT((a.outline.head - truth.head()).norm(), 0.03);
+  expectNoisyTargets(a, design);
 }
 
 TEST(Pipeline, DenseNoisyMainsailKeepsItsEndAnglesWithinTheNoiseTargets) {
@@ -168,19 +174,7 @@ TEST(Pipeline, DenseNoisyMainsailKeepsItsEndAnglesWithinTheNoiseTargets) {
   sim.noise_sigma_m = 0.004;
   sim.seed = 3;
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
-  const SailSurface truth(design);
-  ASSERT_EQ(a.sections.sections.size(), 3u);
-  for (const Section& s : a.sections.sections) {
-    const KnownSection k = truth.section(s.fraction);
-    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, 0.3);
-    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, 2.0);
-    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, 0.3);
-    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, 2.5);
-    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, 2.5);
-  }
-  EXPECT_LT((a.outline.tack - truth.tack()).norm(), 0.03);
-  EXPECT_LT((a.outline.clew - truth.clew()).norm(), 0.03);
-  EXPECT_LT((a.outline.head - truth.head()).norm(), 0.03);
+  expectNoisyTargets(a, design);
 }
 
 TEST(Pipeline, SceneWithMastBoomAndDeckIsSegmentedToTheSail) {
@@ -203,19 +197,7 @@ TEST(Pipeline, SceneWithMastBoomAndDeckIsSegmentedToTheSail) {
   EXPECT_NEAR(a.spars[1].spar.radius_m, 0.06, kSigma / 2);
   // With them known, the luff strip their neighbourhoods reached into comes back, and
   // the sections and corners meet the noisy sail-alone targets (issue 2) beside them.
-  const SailSurface truth(design);
-  ASSERT_EQ(a.sections.sections.size(), 3u);
-  for (const Section& s : a.sections.sections) {
-    const KnownSection k = truth.section(s.fraction);
-    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, 0.3);
-    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, 2.0);
-    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, 0.3);
-    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, 2.5);
-    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, 2.5);
-  }
-  EXPECT_LT((a.outline.tack - truth.tack()).norm(), 0.03);
-  EXPECT_LT((a.outline.clew - truth.clew()).norm(), 0.03);
-  EXPECT_LT((a.outline.head - truth.head()).norm(), 0.03);
+  expectNoisyTargets(a, design);
 }
 
 TEST(Pipeline, EmptyCloudIsRejected) {
