@@ -180,7 +180,10 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
                        std::to_string(p.fair_m) + ")");
   if (!(p.anchor_ratio >= 0 && p.anchor_ratio <= 1))
     throw InvalidInput("[smoothMls] anchor_ratio must be in [0, 1] (got " + std::to_string(p.anchor_ratio) + ")");
-  const size_t k = static_cast<size_t>(p.k_neighbours);
+  if (!(p.reference_density_per_m2 >= 0))
+    throw InvalidInput("[smoothMls] reference_density_per_m2 must be >= 0 (got " +
+                       std::to_string(p.reference_density_per_m2) + ")");
+  size_t k = static_cast<size_t>(p.k_neighbours);
   if (cloud.size() < k)
     throw InvalidInput("[smoothMls] cloud has " + std::to_string(cloud.size()) + " points, fewer than k_neighbours = " +
                        std::to_string(k));
@@ -192,7 +195,14 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
 
   {
     // The neighbourhood radius: the median k-th neighbour distance over a sample of points.
-    const double radius = std::max(1e-6, medianNeighbourDistance(*gridForNeighbours(pts, k), pts, k, 256));
+    double radius = std::max(1e-6, medianNeighbourDistance(*gridForNeighbours(pts, k), pts, k, 256));
+    const double density = static_cast<double>(k) / (M_PI * radius * radius);  // points/m² on the surface
+    if (p.reference_density_per_m2 > 0 && density > p.reference_density_per_m2) {
+      k = std::min(pts.size(), static_cast<size_t>(std::lround(static_cast<double>(k) *
+                                                               std::sqrt(density / p.reference_density_per_m2))));
+      radius = std::max(1e-6, medianNeighbourDistance(*gridForNeighbours(pts, k), pts, k, 256));
+    }
+    result.k_used = k;
     // Gathered from a grid a little wider than the radius, so the k nearest of
     // most points whose radius holds fewer than k are among the candidates too.
     const double reach = 1.3 * radius;

@@ -257,6 +257,24 @@ TEST(SmoothMls, CarriesAttributesOver) {
   EXPECT_EQ(*s.cloud.viewpoint, Vec3(1, 2, 3));
 }
 
+TEST(SmoothMls, TakesMoreNeighboursInADenseCloud) {
+  // 64,000 points on 4 m²: 16,000 points/m², four times the reference density,
+  // so k doubles (√4); the median k-th neighbour distance estimates the density
+  // to a few per cent (edges pull it down a little).
+  const Cloud dense = noisyPlane(64000, kSigma, 3);
+  const SmoothingParams p;
+  const Smoothing scaled = smoothMls(dense, p);
+  EXPECT_NEAR(static_cast<double>(scaled.k_used), 2.0 * p.k_neighbours, 0.15 * 2.0 * p.k_neighbours);
+  SmoothingParams fixed = p;
+  fixed.reference_density_per_m2 = 0;
+  const Smoothing plain = smoothMls(dense, fixed);
+  EXPECT_EQ(plain.k_used, static_cast<size_t>(p.k_neighbours));
+  // The value left at a point varies as 1/k: twice the neighbours, √2 less noise.
+  EXPECT_LT(rmsOffPlane(scaled.cloud), 0.85 * rmsOffPlane(plain.cloud));
+  // Below the reference density k stays as set: 8,000 points on 4 m².
+  EXPECT_EQ(smoothMls(noisyPlane(8000, kSigma, 4), p).k_used, static_cast<size_t>(p.k_neighbours));
+}
+
 TEST(SmoothMls, RejectsBadParametersAndSmallClouds) {
   const Cloud in = noisyPlane(100, kSigma, 7);
   auto with = [](auto change) {
@@ -277,6 +295,9 @@ TEST(SmoothMls, RejectsBadParametersAndSmallClouds) {
   expectInvalidInput([&] { smoothMls(in, with([](auto& p) { p.k_neighbours = 101; })); },
                      {"[smoothMls]", "100 points", "k_neighbours = 101"});
   expectInvalidInput([&] { smoothMls(Cloud{}, SmoothingParams{}); }, {"[smoothMls]", "0 points"});
+  for (double rho : {-1.0, std::nan("")})
+    expectInvalidInput([&] { smoothMls(in, with([rho](auto& p) { p.reference_density_per_m2 = rho; })); },
+                       {"[smoothMls]", "reference_density_per_m2 must be >= 0"});
   // The limits themselves are accepted.
   EXPECT_EQ(smoothMls(in, with([](auto& p) { p.k_neighbours = 6; })).cloud.size(), in.size());
   EXPECT_EQ(smoothMls(noisyPlane(300, kSigma, 8), with([](auto& p) { p.k_neighbours = 256; })).cloud.size(), 300u);
