@@ -227,11 +227,58 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
     // The points every query in one grid cell reads (PointGrid::cellNeighbourhood),
     // gathered once for all of that cell's fits.
     struct Gathered {
+      size_t cell = 0;
       std::vector<uint32_t> index;
       std::vector<Vec3> points;
+      // The cells within two reaches, gathered at the cell's first edge refit.
+      bool has_wide = false;
+      std::vector<uint32_t> wide_index;
+      std::vector<Vec3> wide_points;
+      void gather(const PointGrid& g, size_t c, double r) {
+        cell = c;
+        has_wide = false;
+        g.cellNeighbourhood(c, r, index, points);
+      }
     };
     const double reach2 = reach * reach;
-    auto fitAt = [&](const Vec3& at, Buffers& b, float* used_radius, const Gathered* near) {
+    const double wide_reach = 2.0 * reach;
+    // Rings of cells the wide gathering covers around its cell, as PointGrid counts them.
+    const double wide_rings = std::ceil(wide_reach * (1.0 / grid.cellSize()));
+    // The k_edge nearest of `at` sorted by (distance², index), as grid.nearest gives
+    // them, from the wide gathering: those within limit2 (at most where the gathering
+    // surely holds every point) when k_edge of them are; false otherwise.
+    auto nearestFromWide = [&](const Vec3& at, double limit2, Buffers& b, Gathered& g) {
+      if (!g.has_wide) {
+        grid.cellNeighbourhood(g.cell, wide_reach, g.wide_index, g.wide_points);
+        g.has_wide = true;
+      }
+      const double cell = grid.cellSize();
+      const double margin =
+          std::max(0.0, 0.5 * cell - (at - grid.cellCentre(g.cell)).cwiseAbs().maxCoeff() - 1e-9 * cell);
+      const double sure = wide_rings * cell + margin;
+      if (g.wide_index.size() < pts.size()) limit2 = std::min(limit2, sure * sure);
+      const size_t m = g.wide_index.size();
+      b.order.resize(m);
+      size_t within = 0;
+      for (size_t j = 0; j < m; ++j) {
+        const double d = (g.wide_points[j] - at).squaredNorm();
+        b.order[within] = {d, g.wide_index[j]};
+        within += d <= limit2 ? 1 : 0;
+      }
+      if (within < k_edge) return false;
+      b.order.resize(within);
+      const long kk = static_cast<long>(k_edge);
+      std::nth_element(b.order.begin(), b.order.begin() + (kk - 1), b.order.end());
+      std::sort(b.order.begin(), b.order.begin() + kk);
+      b.cand.resize(k_edge);
+      b.cand_d2.resize(k_edge);
+      for (size_t j = 0; j < k_edge; ++j) {
+        b.cand_d2[j] = b.order[j].first;
+        b.cand[j] = b.order[j].second;
+      }
+      return true;
+    };
+    auto fitAt = [&](const Vec3& at, Buffers& b, float* used_radius, Gathered* near) {
       if (near) {
         // The same candidates, in the same order, as grid.withinRadius(at, reach).
         const size_t m = near->index.size();
@@ -286,7 +333,9 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
       }
       LocalSurface fit = fitLocal(b.row_pts.data(), b.row_d2.data(), b.row_pts.size(), at, p.polynomial_order, h2);
       if (fit.centroid_offset > kInsideCentroidOffset && k_edge > b.row_pts.size()) {
-        grid.nearest(at, k_edge, b.cand, b.cand_d2);
+        // Twice the points lie within about √2 the radius that held k (1.6 leaves room
+        // for a density falling off towards the edge); further out only if not.
+        if (!near || !nearestFromWide(at, 2.56 * h2, b, *near)) grid.nearest(at, k_edge, b.cand, b.cand_d2);
         b.row_pts.resize(k_edge);
         h2 = 0;
         for (size_t j = 0; j < k_edge; ++j) {
@@ -335,7 +384,7 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
         for (long c = 0; c < static_cast<long>(cells); ++c) {
           const size_t cs = static_cast<size_t>(c);
           if (anchor_start[cs] == anchor_start[cs + 1]) continue;
-          grid.cellNeighbourhood(cs, reach, near.index, near.points);
+          near.gather(grid, cs, reach);
           for (uint32_t s = anchor_start[cs]; s < anchor_start[cs + 1]; ++s) {
             const uint32_t a = by_cell[s];
             surfaces[a] = fitAt(pts[anchors[a]], b, &anchor_radius[a], &near);
@@ -402,7 +451,7 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
             for (uint32_t a : near) all_inside = all_inside && inside[a];
             if (!all_inside) {
               own_fit[i] = 1;
-              if (!gathered) grid.cellNeighbourhood(cs, reach, near_points.index, near_points.points);
+              if (!gathered) near_points.gather(grid, cs, reach);
               gathered = true;
               result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i], &near_points).project(pts[i]);
               continue;
