@@ -62,6 +62,13 @@ VoxelSample voxelSample(const Cloud& in, double voxel) {
   return out;
 }
 
+// The readmit parameters with the pipeline's default offset: 0 means 3 sensor σ.
+ReadmitParams readmitParams(const AnalysisParams& p) {
+  ReadmitParams rp = p.readmit;
+  if (rp.max_offset_m == 0) rp.max_offset_m = 3.0 * p.sensor_sigma_m;
+  return rp;
+}
+
 // Finds round spars among the points near the sail cluster `sail` (indices into
 // `cloud`); when there are any, the sail loses its points on them and gains the
 // unclustered points that lie on its surface and off every spar: the strip along
@@ -92,29 +99,30 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
     for (const SparFit& f : found.spars) d = std::min(d, distanceToSpar(x, f.spar));
     return d;
   };
+  std::vector<char> loose(cloud.size(), 0);
+  for (uint32_t i : seg.unassigned) loose[i] = !in_sail[i];
   // Sail points within 2σ of a spar's surface are more likely the spar's; loose
   // points within 3σ of it stay out (the sail is at least 2 cm off a mast's aft face).
-  std::vector<uint32_t> sub;
-  for (uint32_t i : sail)
-    if (nearestSpar(cloud.points[i]) > 2 * sigma) sub.push_back(i);
-  const size_t sail_kept = sub.size();
-  for (uint32_t i : seg.unassigned)
-    if (!in_sail[i] && box.contains(cloud.points[i]) && nearestSpar(cloud.points[i]) > 3 * sigma) sub.push_back(i);
-  if (sub.size() == sail_kept || sail_kept == 0) return sub;
-  std::vector<uint32_t> order(sub.size());
-  for (uint32_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return sub[x] < sub[y]; });
-  std::vector<uint32_t> sorted_sub(sub.size()), kept;
-  for (uint32_t k = 0; k < order.size(); ++k) {
-    sorted_sub[k] = sub[order[k]];
-    if (order[k] < sail_kept) kept.push_back(k);
+  // `sub` ascends, and `kept` indexes the sail's part of it, as readmitSurfacePoints needs.
+  std::vector<uint32_t> sub, kept;
+  for (uint32_t i = 0; i < cloud.size(); ++i) {
+    if (in_sail[i] && nearestSpar(cloud.points[i]) > 2 * sigma) {
+      kept.push_back(static_cast<uint32_t>(sub.size()));
+      sub.push_back(i);
+    } else if (loose[i] && box.contains(cloud.points[i]) && nearestSpar(cloud.points[i]) > 3 * sigma) {
+      sub.push_back(i);
+    }
   }
-  ReadmitParams rp = p.readmit;
-  if (!(rp.max_offset_m > 0)) rp.max_offset_m = 3 * sigma;
-  const Cleaning back = readmitSurfacePoints(selectPoints(cloud, sorted_sub), kept, rp);
+  if (sub.size() == kept.size() || kept.empty()) {
+    std::vector<uint32_t> out;
+    out.reserve(kept.size());
+    for (uint32_t k : kept) out.push_back(sub[k]);
+    return out;
+  }
+  const Cleaning back = readmitSurfacePoints(selectPoints(cloud, sub), kept, readmitParams(p));
   std::vector<uint32_t> out;
   out.reserve(back.kept.size());
-  for (uint32_t k : back.kept) out.push_back(sorted_sub[k]);
+  for (uint32_t k : back.kept) out.push_back(sub[k]);
   return out;
 }
 
@@ -201,9 +209,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
   }
   if ((p.statistical_outliers || p.radius_outliers) && p.readmit_surface_points && kept.size() < segmented.size()) {
     StageTimer t(a, "readmit surface points", cloud.size());
-    ReadmitParams rp = p.readmit;
-    if (rp.max_offset_m == 0) rp.max_offset_m = 3.0 * p.sensor_sigma_m;
-    const Cleaning c = readmitSurfacePoints(segmented, kept, rp);
+    const Cleaning c = readmitSurfacePoints(segmented, kept, readmitParams(p));
     kept = c.kept;
     cloud = selectPoints(segmented, kept);
     t.finish(cloud.size(), c.warnings);

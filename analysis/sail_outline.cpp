@@ -6,6 +6,7 @@
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
+#include "analysis/plane_detection.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
@@ -414,16 +415,8 @@ Vec3 ontoSurface(const Vec3& c, const Mesh& mesh, const PointGrid& tree, double 
     if (idx.size() >= 40) break;
   }
   if (idx.size() < 40) return c;
-  Vec3 mean = Vec3::Zero();
-  for (uint32_t v : idx) mean += mesh.vertices[v];
-  mean /= static_cast<double>(idx.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (uint32_t v : idx) {
-    const Vec3 d = mesh.vertices[v] - mean;
-    cov += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  const Vec3 n = eig.eigenvectors().col(0), eu = eig.eigenvectors().col(2), ev = n.cross(eu);
+  // Any in-plane axes serve: the full quadratic is the same in every rotation of them.
+  const Vec3 n = fitPlane(mesh.vertices, idx).normal, eu = n.unitOrthogonal(), ev = n.cross(eu);
   // Height over (u, v) about the corner, in units of the radius.
   Eigen::MatrixXd A(static_cast<Eigen::Index>(idx.size()), 6);
   Eigen::VectorXd z(static_cast<Eigen::Index>(idx.size()));
