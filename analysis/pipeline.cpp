@@ -226,15 +226,20 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), s.warnings);
   }
 
+  std::vector<Vec3> loose;  // smoothed sail points the mesh left out
   {
     StageTimer t(a, "surface", cloud.size());
     Surface s = reconstructSurface(cloud, p.surface, progress);
     a.mesh = std::move(s.mesh);
+    std::vector<char> meshed(cloud.size(), 0);
+    for (uint32_t i : s.vertex_source) meshed[i] = 1;
+    for (size_t i = 0; i < cloud.size(); ++i)
+      if (!meshed[i]) loose.push_back(cloud.points[i]);
     t.finish(a.mesh.vertices.size(), s.warnings);
   }
   {
     StageTimer t(a, "outline", a.mesh.vertices.size());
-    a.outline = extractOutline(a.mesh, p.outline);
+    a.outline = extractOutline(a.mesh, p.outline, loose);
     a.luff = measureLuffCurve(a.outline);
     t.finish(a.outline.boundary.size(), a.outline.warnings);
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
@@ -325,6 +326,10 @@ struct Meeting {
   Vec3 outward = Vec3::Zero();  // unit, out of the sail along the corner's bisector
   double angle_rad = 0;         // interior angle between the two edges
   double sigma_along_m = 0;     // 1σ of `point` along `outward`
+  // Each edge's unit normal into the sail (in the corner's plane) and its 1σ
+  // sideways uncertainty at the corner.
+  Vec3 inward_a = Vec3::Zero(), inward_b = Vec3::Zero();
+  double side_a_m = 0, side_b_m = 0;
 };
 
 // The closest pair of points of the two edges' corner curves (quadratics in the
@@ -365,7 +370,61 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
   const double side_a = std::hypot(ca.sigma_at_corner, a.sigma, 0.5 * a.recess);
   const double side_b = std::hypot(cb.sigma_at_corner, b.sigma, 0.5 * b.recess);
   m.sigma_along_m = std::hypot(side_a, side_b) / (2.0 * std::sin(half));
+  const Vec3 across_a = tb - tb.dot(ta) * ta, across_b = ta - ta.dot(tb) * tb;
+  if (across_a.norm() > 1e-9 && across_b.norm() > 1e-9) {
+    m.inward_a = across_a.normalized();
+    m.inward_b = across_b.normalized();
+  }
+  m.side_a_m = side_a;
+  m.side_b_m = side_b;
   return m;
+}
+
+// The sail's surface around a corner: the quadratic height field of the mesh
+// vertices around it (at least 40 of them, within 10-160 boundary spacings).
+// Close to the corner it reaches the few spacings beyond the samples far better
+// than the edges' corner curves, which extrapolate their own bend.
+struct HeightField {
+  Vec3 origin = Vec3::Zero(), normal = Vec3::UnitZ(), eu = Vec3::UnitX(), ev = Vec3::UnitY();
+  double radius = 1;                                     // (u, v) are in units of it
+  Eigen::Matrix<double, 6, 1> h = Eigen::Matrix<double, 6, 1>::Zero();
+  double rms_m = 0;                                      // the vertices' scatter about it
+  // Signed height of q over the field, along `normal`.
+  double offset(const Vec3& q) const {
+    const Vec3 d = q - origin;
+    const double u = d.dot(eu) / radius, v = d.dot(ev) / radius;
+    return d.dot(normal) - (h[0] + h[1] * u + h[2] * v + h[3] * u * u + h[4] * u * v + h[5] * v * v);
+  }
+};
+
+std::optional<HeightField> heightFieldAround(const Vec3& c, const Mesh& mesh, const PointGrid& tree, double spacing) {
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  double radius = 10.0 * spacing;
+  for (int i = 0; i < 5; ++i, radius *= 2.0) {
+    tree.withinRadius(c, radius, idx, d2);
+    if (idx.size() >= 40) break;
+  }
+  if (idx.size() < 40) return std::nullopt;
+  HeightField f;
+  f.origin = c;
+  f.radius = radius;
+  // Any in-plane axes serve: the full quadratic is the same in every rotation of them.
+  f.normal = fitPlane(mesh.vertices, idx).normal;
+  f.eu = f.normal.unitOrthogonal();
+  f.ev = f.normal.cross(f.eu);
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(idx.size()), 6);
+  Eigen::VectorXd z(static_cast<Eigen::Index>(idx.size()));
+  for (size_t i = 0; i < idx.size(); ++i) {
+    const Vec3 d = mesh.vertices[idx[i]] - c;
+    const double u = d.dot(f.eu) / radius, v = d.dot(f.ev) / radius;
+    A.row(static_cast<Eigen::Index>(i)) << 1, u, v, u * u, u * v, v * v;
+    z[static_cast<Eigen::Index>(i)] = d.dot(f.normal);
+  }
+  f.h = A.colPivHouseholderQr().solve(z);
+  if (!f.h.allFinite()) return std::nullopt;
+  f.rms_m = std::sqrt((A * f.h - z).squaredNorm() / std::max<double>(1.0, static_cast<double>(idx.size()) - 6));
+  return f;
 }
 
 // At a narrow corner (the head of most sails) the crossing of the two edges is
@@ -374,7 +433,8 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
 // length L beyond it, sampled at ρ points/m², stays empty with probability
 // exp(−ρ·L²·tan(angle/2)) (the wedge's area). The corner is placed at the mean
 // of the crossing's Gaussian times that probability, for L ≥ 0.
-Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, double density, double reach) {
+Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, const std::vector<Vec3>& loose,
+                 double density, double reach, double spacing) {
   if (m.outward.isZero() || !(density > 0) || !(m.sigma_along_m > 0)) return m.point;
   std::vector<uint32_t> idx;
   std::vector<double> d2;
@@ -382,6 +442,21 @@ Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, doub
   if (idx.empty()) return m.point;
   double extreme = -std::numeric_limits<double>::infinity();
   for (uint32_t v : idx) extreme = std::max(extreme, (mesh.vertices[v] - m.point).dot(m.outward));
+  // A sample the mesh left out (its triangles' edges too long: a lone sample
+  // near a narrow tip) still says how far the sail reaches, if it lies inside
+  // both edges and on the surface.
+  if (!loose.empty() && !m.inward_a.isZero()) {
+    const std::optional<HeightField> field = heightFieldAround(m.point, mesh, tree, spacing);
+    for (const Vec3& q : loose) {
+      const Vec3 d = q - m.point;
+      if (!field || d.squaredNorm() > reach * reach) continue;
+      const bool inside = d.dot(m.inward_a) >= -2.0 * m.side_a_m && d.dot(m.inward_b) >= -2.0 * m.side_b_m;
+      // The smoothed points lie within a few scatters of the field; the floor
+      // stands in where the scatter is next to nothing (a clean scan).
+      const bool on_surface = std::abs(field->offset(q)) <= std::max(3.0 * field->rms_m, 0.2 * spacing);
+      if (inside && on_surface) extreme = std::max(extreme, d.dot(m.outward));
+    }
+  }
   const double lambda = density * std::tan(std::min(0.5 * m.angle_rad, 1.4));
   const double gap_scale = 1.0 / std::sqrt(lambda);  // typical empty tip length, m
   const double s = m.sigma_along_m;
@@ -402,33 +477,11 @@ Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, doub
 // The edges' crossing is placed well within the sail's surface but not in depth:
 // there each edge's corner curve extrapolates its own bend (a foot leaves the
 // tack at the entry angle and curves away), and a jib's tack came out 3 cm off
-// the surface. The corner lies on the surface: the quadratic height field of the
-// mesh vertices around it (at least 40 of them, within 10-160 boundary
-// spacings), which reaches the few spacings beyond the samples to the corner far
-// better, and the corner moves onto it along its normal.
+// the surface. The corner lies on the surface: it moves onto the height field
+// along its normal.
 Vec3 ontoSurface(const Vec3& c, const Mesh& mesh, const PointGrid& tree, double spacing) {
-  std::vector<uint32_t> idx;
-  std::vector<double> d2;
-  double radius = 10.0 * spacing;
-  for (int i = 0; i < 5; ++i, radius *= 2.0) {
-    tree.withinRadius(c, radius, idx, d2);
-    if (idx.size() >= 40) break;
-  }
-  if (idx.size() < 40) return c;
-  // Any in-plane axes serve: the full quadratic is the same in every rotation of them.
-  const Vec3 n = fitPlane(mesh.vertices, idx).normal, eu = n.unitOrthogonal(), ev = n.cross(eu);
-  // Height over (u, v) about the corner, in units of the radius.
-  Eigen::MatrixXd A(static_cast<Eigen::Index>(idx.size()), 6);
-  Eigen::VectorXd z(static_cast<Eigen::Index>(idx.size()));
-  for (size_t i = 0; i < idx.size(); ++i) {
-    const Vec3 d = mesh.vertices[idx[i]] - c;
-    const double u = d.dot(eu) / radius, v = d.dot(ev) / radius;
-    A.row(static_cast<Eigen::Index>(i)) << 1, u, v, u * u, u * v, v * v;
-    z[static_cast<Eigen::Index>(i)] = d.dot(n);
-  }
-  const Eigen::VectorXd h = A.colPivHouseholderQr().solve(z);
-  if (!h.allFinite()) return c;
-  return c + h[0] * n;
+  const std::optional<HeightField> f = heightFieldAround(c, mesh, tree, spacing);
+  return f ? Vec3(c + f->h[0] * f->normal) : c;
 }
 
 // The edge from corner to corner: the fitted curve between the excluded ends.
@@ -463,7 +516,7 @@ Vec3 pointAtFraction(const std::vector<Vec3>& line, double fraction) {
   return line.back();
 }
 
-SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
+SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::vector<Vec3>& loose_points) {
   if (mesh.triangles.empty()) throw InvalidInput("[extractOutline] empty mesh");
   if (p.corners != 0 && p.corners != 3 && p.corners != 4)
     throw InvalidInput("[extractOutline] corners must be 0 (auto), 3 or 4 (got " + std::to_string(p.corners) + ")");
@@ -613,7 +666,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p) {
   const double density = static_cast<double>(mesh.vertices.size()) / std::max(1e-12, mesh_area);
   const double reach = std::max(0.05 * total, 10.0 * sp);
   auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start) {
-    const Vec3 c = placeCorner(meetEdges(a, a_start, b, b_start, sp), mesh, tree, density, reach);
+    const Vec3 c = placeCorner(meetEdges(a, a_start, b, b_start, sp), mesh, tree, loose_points, density, reach, sp);
     return ontoSurface(c, mesh, tree, sp);
   };
   out.tack = corner(luff, true, foot, true);

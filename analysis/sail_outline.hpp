@@ -40,7 +40,11 @@ struct SailOutline {
 
 // Throws AnalysisError when the mesh has no boundary loop, the corners cannot be
 // told apart, or a length is more than design_tolerance off its design value.
-SailOutline extractOutline(const Mesh& mesh, const OutlineParams& params = {});
+// `loose_points`: points of the sail the mesh left out (a lone sample near a
+// narrow tip whose triangles were trimmed as too long); a corner reaches at
+// least to those of them that lie inside both its edges and on the surface.
+SailOutline extractOutline(const Mesh& mesh, const OutlineParams& params = {},
+                           const std::vector<Vec3>& loose_points = {});
 
 // Length of a polyline, m.
 double polylineLength(const std::vector<Vec3>& line);

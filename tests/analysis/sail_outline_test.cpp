@@ -5,7 +5,9 @@
 #include <cmath>
 
 #include "analysis/errors.hpp"
+#include "analysis/sail_generator.hpp"
 #include "analysis/sail_outline.hpp"
+#include "analysis/surface.hpp"
 #include "tests/analysis/fixtures.hpp"
 
 namespace sailshape {
@@ -65,6 +67,51 @@ TEST(SailOutline, AClosedSurfaceHasNoBoundary) {
   m.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
   m.triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};  // a tetrahedron, faces outward
   EXPECT_THROW(extractOutline(m), AnalysisError);
+}
+
+// A mainsail's head whose last samples stand apart: every sample within 12 cm
+// of the head but the one nearest it is gone, and that one is not in the mesh
+// (as when the surface's long-edge trimming leaves a lone tip sample out).
+TEST(SailOutline, AHeadReachesTheLooseSampleTheMeshLeftOut) {
+  const SailDesign design = exampleDesign(SailType::Main);
+  const SailSurface truth(design);
+  ScanSimulation sim;
+  sim.points = 40'000;
+  sim.seed = 5;
+  const Cloud sampled = sampleSail(design, sim);
+  const Vec3 head = truth.head();
+  Cloud kept;
+  Vec3 tip = Vec3::Zero();
+  double tip_d = 1e9;
+  for (const Vec3& p : sampled.points) {
+    const double d = (p - head).norm();
+    if (d >= 0.12)
+      kept.points.push_back(p);
+    else if (d < tip_d) {
+      tip_d = d;
+      tip = p;
+    }
+  }
+  ASSERT_LT(tip_d, 0.05) << "the sampling left no sample near the head";
+  const Mesh mesh = reconstructSurface(kept).mesh;
+
+  const SailOutline without = extractOutline(mesh);
+  const SailOutline with = extractOutline(mesh, {}, {tip});
+  // The head lies at or beyond its outermost sample: along the luff-leech bisector
+  // (here, to well under a degree, straight up) the head reaches the lone sample.
+  const Vec3 up = (head - 0.5 * (truth.luffPoint(0.98) + truth.leechPoint(0.98))).normalized();
+  EXPECT_GE((with.head - tip).dot(up), -0.002) << "head " << with.head.transpose() << ", tip " << tip.transpose();
+  EXPECT_LT((with.head - head).norm(), 0.03);
+  // Without it the head stops short of the sample: the mesh ends 12 cm below the head.
+  EXPECT_LT((without.head - tip).dot(up), -0.005);
+
+  // A point beyond the luff, or off the surface, is no sample of this sail's tip.
+  const Vec3 across = up.cross(truth.luffPoint(0.98) - truth.leechPoint(0.98)).normalized();  // off the surface
+  const Vec3 forward = (truth.luffPoint(0.98) - truth.leechPoint(0.98)).normalized();
+  for (const Vec3& stray : {Vec3(tip + 0.10 * forward), Vec3(tip + 0.05 * across)}) {
+    const SailOutline o = extractOutline(mesh, {}, {stray});
+    EXPECT_LT((o.head - without.head).norm(), 1e-9) << "stray " << stray.transpose();
+  }
 }
 
 }  // namespace
