@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "analysis/errors.hpp"
@@ -42,13 +43,11 @@ inline double expWeight(double x) {
   return e * e;
 }
 
-// Weighted plane, then (order 2) a weighted quadratic height field over it,
-// from the neighbours `nb` (squared distances d2 from the point `at`, none
-// beyond the radius² h2) of the point `at`.
-LocalSurface fitLocal(const Vec3* nb, const double* d2, size_t k, const Vec3& at, int order, double h2) {
+// The weighted plane through the neighbours `nb` (squared distances d2 from the
+// point `at`, none beyond the radius² h2) of the point `at`; their weights go to w.
+LocalSurface fitPlane(const Vec3* nb, const double* d2, size_t k, const Vec3& at, double h2, std::vector<double>& w) {
   LocalSurface s;
   h2 = std::max(1e-12, h2);
-  thread_local std::vector<double> w;
   w.resize(k);
   const double g = -2.0 / h2;  // the radius is 2σ of the weights
   for (size_t j = 0; j < k; ++j) w[j] = expWeight(std::max(-2.0, g * d2[j]));
@@ -84,50 +83,104 @@ LocalSurface fitLocal(const Vec3* nb, const double* d2, size_t k, const Vec3& at
   s.origin = at - s.normal * s.normal.dot(at - mean);
   s.centroid_offset = (mean - s.origin).norm() / std::sqrt(h2);
   s.scale = 1.0 / std::sqrt(h2);
-  if (order == 2) {
-    // The normal equations need the weighted moments of u^a v^b up to a + b = 4
-    // and of z u^a v^b up to a + b = 2.
-    double M[15] = {}, Z[6] = {};
-    const Vec3 eu = s.eu * s.scale, ev = s.ev * s.scale;
-    for (size_t j = 0; j < k; ++j) {
-      const Vec3 d = nb[j] - s.origin;
-      const double u = d.dot(eu), v = d.dot(ev), z = d.dot(s.normal), wj = w[j];
-      const double uu = u * u, uv = u * v, vv = v * v;
-      const double wu = wj * u, wv = wj * v, wuu = wj * uu, wuv = wj * uv, wvv = wj * vv;
-      M[0] += wj;
-      M[1] += wu;
-      M[2] += wv;
-      M[3] += wuu;
-      M[4] += wuv;
-      M[5] += wvv;
-      M[6] += wuu * u;   // u³
-      M[7] += wuu * v;   // u²v
-      M[8] += wvv * u;   // uv²
-      M[9] += wvv * v;   // v³
-      M[10] += wuu * uu;  // u⁴
-      M[11] += wuu * uv;  // u³v
-      M[12] += wuu * vv;  // u²v²
-      M[13] += wuv * vv;  // uv³
-      M[14] += wvv * vv;  // v⁴
-      Z[0] += wj * z;
-      Z[1] += wu * z;
-      Z[2] += wv * z;
-      Z[3] += wuu * z;
-      Z[4] += wuv * z;
-      Z[5] += wvv * z;
-    }
-    // Basis 1, u, v, u², uv, v²: entry (i, j) is the moment of basis_i · basis_j.
-    const int idx[6][6] = {{0, 1, 2, 3, 4, 5},   {1, 3, 4, 6, 7, 8},    {2, 4, 5, 7, 8, 9},
-                           {3, 6, 7, 10, 11, 12}, {4, 7, 8, 11, 12, 13}, {5, 8, 9, 12, 13, 14}};
-    Eigen::Matrix<double, 6, 6> A;
-    for (int i = 0; i < 6; ++i)
-      for (int j = 0; j < 6; ++j) A(i, j) = M[idx[i][j]];
-    const Eigen::Matrix<double, 6, 1> b = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(Z);
-    Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(A);
-    const Eigen::Matrix<double, 6, 1> c = ldlt.solve(b);
-    if (ldlt.info() == Eigen::Success && c.allFinite()) s.c = c;
-  }
   return s;
+}
+
+// The weighted quadratic height field over the plane `s` (from fitPlane, with the
+// same neighbours and their weights w).
+void fitQuadratic(LocalSurface& s, const Vec3* nb, size_t k, const std::vector<double>& w) {
+  // The normal equations need the weighted moments of u^a v^b up to a + b = 4
+  // and of z u^a v^b up to a + b = 2.
+  double M[15] = {}, Z[6] = {};
+  const Vec3 eu = s.eu * s.scale, ev = s.ev * s.scale;
+  for (size_t j = 0; j < k; ++j) {
+    const Vec3 d = nb[j] - s.origin;
+    const double u = d.dot(eu), v = d.dot(ev), z = d.dot(s.normal), wj = w[j];
+    const double uu = u * u, uv = u * v, vv = v * v;
+    const double wu = wj * u, wv = wj * v, wuu = wj * uu, wuv = wj * uv, wvv = wj * vv;
+    M[0] += wj;
+    M[1] += wu;
+    M[2] += wv;
+    M[3] += wuu;
+    M[4] += wuv;
+    M[5] += wvv;
+    M[6] += wuu * u;   // u³
+    M[7] += wuu * v;   // u²v
+    M[8] += wvv * u;   // uv²
+    M[9] += wvv * v;   // v³
+    M[10] += wuu * uu;  // u⁴
+    M[11] += wuu * uv;  // u³v
+    M[12] += wuu * vv;  // u²v²
+    M[13] += wuv * vv;  // uv³
+    M[14] += wvv * vv;  // v⁴
+    Z[0] += wj * z;
+    Z[1] += wu * z;
+    Z[2] += wv * z;
+    Z[3] += wuu * z;
+    Z[4] += wuv * z;
+    Z[5] += wvv * z;
+  }
+  // Basis 1, u, v, u², uv, v²: entry (i, j) is the moment of basis_i · basis_j.
+  const int idx[6][6] = {{0, 1, 2, 3, 4, 5},   {1, 3, 4, 6, 7, 8},    {2, 4, 5, 7, 8, 9},
+                         {3, 6, 7, 10, 11, 12}, {4, 7, 8, 11, 12, 13}, {5, 8, 9, 12, 13, 14}};
+  Eigen::Matrix<double, 6, 6> A;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) A(i, j) = M[idx[i][j]];
+  const Eigen::Matrix<double, 6, 1> b = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(Z);
+  Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(A);
+  const Eigen::Matrix<double, 6, 1> c = ldlt.solve(b);
+  if (ldlt.info() == Eigen::Success && c.allFinite()) s.c = c;
+}
+
+// Of the slots j with d2[j] <= limit2, the k nearest by (distance², slot) into
+// `out`; returns the k-th distance², or -1 when fewer than k lie within limit2.
+// The squared distances are counted in bins of limit2 / kBins (a sample spread
+// evenly over a surface spreads its squared distances evenly too), and only the
+// bin holding the k-th is selected from: one pass over the candidates instead of
+// the several a general selection makes. `bin` and `part` are scratch.
+double selectNearest(const std::vector<double>& d2, double limit2, size_t k, std::vector<uint8_t>& bin,
+                     std::vector<uint32_t>& part, std::vector<double>& part_d2, std::vector<uint32_t>& out) {
+  constexpr int kBins = 128;  // bin kBins: beyond limit2
+  uint32_t count[kBins + 1] = {};
+  const double scale = limit2 > 0 && std::isfinite(limit2) ? kBins / limit2 : 0.0;
+  const size_t m = d2.size();
+  bin.resize(m);
+  for (size_t j = 0; j < m; ++j) {
+    const double s = d2[j] * scale;
+    const int b = d2[j] <= limit2 ? std::min(static_cast<int>(s), kBins - 1) : kBins;
+    bin[j] = static_cast<uint8_t>(b);
+    ++count[b];
+  }
+  size_t below = 0;
+  int last = 0;  // the bin holding the k-th nearest
+  while (last < kBins && below + count[last] < k) below += count[last++];
+  if (last == kBins) return -1;
+  // Slots of the nearer bins are all in; those of bin `last` are selected from.
+  out.resize(m);
+  part.resize(m);
+  size_t o = 0, q = 0;
+  for (size_t j = 0; j < m; ++j) {
+    out[o] = static_cast<uint32_t>(j);
+    part[q] = static_cast<uint32_t>(j);
+    o += bin[j] < last ? 1 : 0;
+    q += bin[j] == last ? 1 : 0;
+  }
+  const size_t need = k - below;
+  part_d2.resize(q);
+  for (size_t j = 0; j < q; ++j) part_d2[j] = d2[part[j]];
+  std::nth_element(part_d2.begin(), part_d2.begin() + static_cast<long>(need - 1), part_d2.begin() + static_cast<long>(q));
+  const double t = part_d2[need - 1];
+  size_t ties = 1;  // how many at exactly t belong to the k: the lowest slots
+  for (size_t j = 0; j + 1 < need; ++j) ties += part_d2[j] == t ? 1 : 0;
+  for (size_t j = 0; j < q; ++j) {
+    const double d = d2[part[j]];
+    const bool tie = d == t && ties > 0;
+    out[o] = part[j];
+    o += (d < t || tie) ? 1 : 0;
+    ties -= tie ? 1 : 0;
+  }
+  out.resize(o);
+  return t;
 }
 
 // Anchored MLS: an anchor whose neighbours' centroid lies within this many radii
@@ -208,12 +261,7 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
     const double reach = 1.3 * radius;
     const PointGrid grid(pts, reach);
     const double r2 = radius * radius;
-    struct Buffers {
-      std::vector<uint32_t> cand;
-      std::vector<double> cand_d2, row_d2;
-      std::vector<Vec3> cand_pts, row_pts;
-      std::vector<std::pair<double, uint32_t>> order;
-    };
+    const double reach2 = reach * reach;
     // The local surface at `at`: the points within the radius, or the k nearest
     // where the radius holds fewer than k (an edge, a sparse patch); the
     // neighbourhood radius used goes to *used_radius.
@@ -224,130 +272,143 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
     // made again from the 2k nearest, which reach about as far into the surface
     // as an inner neighbourhood spans across it.
     const size_t k_edge = std::min(2 * k, pts.size());
-    // The points every query in one grid cell reads (PointGrid::cellNeighbourhood),
-    // gathered once for all of that cell's fits.
+    // Every fit goes cell by cell of `grid` and reads the points every query in its
+    // cell reads (PointGrid::cellNeighbourhood), gathered once per cell with their
+    // coordinates apart (x, y, z: the distance loop vectorises). Rows are taken in
+    // the gathering's order, so a point's fit is the same whichever path fits it.
+    struct Soa {
+      std::vector<double> x, y, z;
+      void assign(const std::vector<Vec3>& p) {
+        x.resize(p.size());
+        y.resize(p.size());
+        z.resize(p.size());
+        for (size_t j = 0; j < p.size(); ++j) {
+          x[j] = p[j].x();
+          y[j] = p[j].y();
+          z[j] = p[j].z();
+        }
+      }
+      // Squared distances from `at` into d2.
+      void distances(const Vec3& at, std::vector<double>& d2) const {
+        const size_t m = x.size();
+        d2.resize(m);
+        const double ax = at.x(), ay = at.y(), az = at.z();
+        const double *px = x.data(), *py = y.data(), *pz = z.data();
+        double* out = d2.data();
+        for (size_t j = 0; j < m; ++j)
+          out[j] = (px[j] - ax) * (px[j] - ax) + (py[j] - ay) * (py[j] - ay) + (pz[j] - az) * (pz[j] - az);
+      }
+      Vec3 at(size_t j) const { return Vec3(x[j], y[j], z[j]); }
+    };
     struct Gathered {
       size_t cell = 0;
-      std::vector<uint32_t> index;
-      std::vector<Vec3> points;
+      Soa near;
       // The cells within two reaches, gathered at the cell's first edge refit.
       bool has_wide = false;
-      std::vector<uint32_t> wide_index;
-      std::vector<Vec3> wide_points;
+      Soa wide;
+      std::vector<uint32_t> index;
+      std::vector<Vec3> points;
       void gather(const PointGrid& g, size_t c, double r) {
         cell = c;
         has_wide = false;
         g.cellNeighbourhood(c, r, index, points);
+        near.assign(points);
       }
     };
-    const double reach2 = reach * reach;
+    struct Buffers {
+      std::vector<double> d2, part_d2, row_d2;
+      std::vector<uint32_t> part, rows, idx;
+      std::vector<uint8_t> bin;
+      std::vector<Vec3> row_pts;
+      std::vector<double> w;
+    };
     const double wide_reach = 2.0 * reach;
     // Rings of cells the wide gathering covers around its cell, as PointGrid counts them.
     const double wide_rings = std::ceil(wide_reach * (1.0 / grid.cellSize()));
-    // The k_edge nearest of `at` sorted by (distance², index), as grid.nearest gives
-    // them, from the wide gathering: those within limit2 (at most where the gathering
-    // surely holds every point) when k_edge of them are; false otherwise.
-    auto nearestFromWide = [&](const Vec3& at, double limit2, Buffers& b, Gathered& g) {
+    // Slots j of `d2` with d2[j] <= limit2 into sel (branch-free: every slot written, kept when within).
+    auto within = [](const std::vector<double>& d2, double limit2, std::vector<uint32_t>& sel) {
+      const size_t m = d2.size();
+      sel.resize(m);
+      size_t o = 0;
+      for (size_t j = 0; j < m; ++j) {
+        sel[o] = static_cast<uint32_t>(j);
+        o += d2[j] <= limit2 ? 1 : 0;
+      }
+      sel.resize(o);
+    };
+    // Rows (points and distance²) of the slots `rows` of gathering `from`.
+    auto takeRows = [](const Soa& from, const std::vector<double>& d2, const std::vector<uint32_t>& rows,
+                       Buffers& b) {
+      b.row_pts.resize(rows.size());
+      b.row_d2.resize(rows.size());
+      for (size_t j = 0; j < rows.size(); ++j) {
+        b.row_pts[j] = from.at(rows[j]);
+        b.row_d2[j] = d2[rows[j]];
+      }
+    };
+    // Rows from a search of the grid (the gathering did not hold enough): the n
+    // nearest sorted by (distance², index); returns the n-th distance².
+    auto nearestRows = [&](const Vec3& at, size_t count, Buffers& b) {
+      grid.nearest(at, count, b.idx, b.row_d2);
+      b.row_pts.resize(b.idx.size());
+      for (size_t j = 0; j < b.idx.size(); ++j) b.row_pts[j] = pts[b.idx[j]];
+      return b.row_d2.back();
+    };
+    // The wide gathering of g's cell (gathered at its first use) and how far around
+    // `at` it surely holds every point, squared.
+    auto wideSure2 = [&](const Vec3& at, Gathered& g) {
       if (!g.has_wide) {
-        grid.cellNeighbourhood(g.cell, wide_reach, g.wide_index, g.wide_points);
+        grid.cellNeighbourhood(g.cell, wide_reach, g.index, g.points);
+        g.wide.assign(g.points);
         g.has_wide = true;
       }
+      if (g.wide.x.size() >= pts.size()) return std::numeric_limits<double>::infinity();
       const double cell = grid.cellSize();
       const double margin =
           std::max(0.0, 0.5 * cell - (at - grid.cellCentre(g.cell)).cwiseAbs().maxCoeff() - 1e-9 * cell);
       const double sure = wide_rings * cell + margin;
-      if (g.wide_index.size() < pts.size()) limit2 = std::min(limit2, sure * sure);
-      const size_t m = g.wide_index.size();
-      b.order.resize(m);
-      size_t within = 0;
-      for (size_t j = 0; j < m; ++j) {
-        const double d = (g.wide_points[j] - at).squaredNorm();
-        b.order[within] = {d, g.wide_index[j]};
-        within += d <= limit2 ? 1 : 0;
-      }
-      if (within < k_edge) return false;
-      b.order.resize(within);
-      const long kk = static_cast<long>(k_edge);
-      std::nth_element(b.order.begin(), b.order.begin() + (kk - 1), b.order.end());
-      std::sort(b.order.begin(), b.order.begin() + kk);
-      b.cand.resize(k_edge);
-      b.cand_d2.resize(k_edge);
-      for (size_t j = 0; j < k_edge; ++j) {
-        b.cand_d2[j] = b.order[j].first;
-        b.cand[j] = b.order[j].second;
-      }
-      return true;
+      return sure * sure;
     };
-    auto fitAt = [&](const Vec3& at, Buffers& b, float* used_radius, Gathered* near) {
-      if (near) {
-        // The same candidates, in the same order, as grid.withinRadius(at, reach).
-        const size_t m = near->index.size();
-        b.cand.resize(m);
-        b.cand_d2.resize(m);
-        b.cand_pts.resize(m);
-        size_t kept = 0;  // written every time, kept when within reach: no branch to mispredict
-        for (size_t j = 0; j < m; ++j) {
-          const double d = (near->points[j] - at).squaredNorm();
-          b.cand[kept] = near->index[j];
-          b.cand_d2[kept] = d;
-          b.cand_pts[kept] = near->points[j];
-          kept += d <= reach2 ? 1 : 0;
-        }
-        b.cand.resize(kept);
-        b.cand_d2.resize(kept);
-        b.cand_pts.resize(kept);
-      } else {
-        grid.withinRadius(at, reach, b.cand, b.cand_d2, &b.cand_pts);
-      }
-      b.row_pts.clear();
-      b.row_d2.clear();
-      for (size_t j = 0; j < b.cand.size(); ++j)
-        if (b.cand_d2[j] <= r2) {
-          b.row_pts.push_back(b.cand_pts[j]);
-          b.row_d2.push_back(b.cand_d2[j]);
-        }
+    // Rows: the `count` nearest of `at` within limit2 from the wide gathering (rows
+    // and distance² of the k-th), else from a search.
+    auto nearestFromWide = [&](const Vec3& at, size_t count, double limit2, Buffers& b, Gathered& g) {
+      limit2 = std::min(limit2, wideSure2(at, g));
+      g.wide.distances(at, b.d2);
+      const double h2 = selectNearest(b.d2, limit2, count, b.bin, b.part, b.part_d2, b.rows);
+      if (h2 < 0) return nearestRows(at, count, b);
+      takeRows(g.wide, b.d2, b.rows, b);
+      return h2;
+    };
+    auto fitAt = [&](const Vec3& at, Buffers& b, float* used_radius, Gathered& g) {
+      g.near.distances(at, b.d2);
+      within(b.d2, r2, b.rows);
       double h2 = r2;
-      if (b.row_pts.size() < k) {
-        b.order.clear();
-        if (b.cand.size() >= k) {
-          // (distance², candidate slot): ties go to the lower slot, the same every run.
-          for (size_t j = 0; j < b.cand.size(); ++j) b.order.emplace_back(b.cand_d2[j], static_cast<uint32_t>(j));
-          std::nth_element(b.order.begin(), b.order.begin() + static_cast<long>(k - 1), b.order.end());
-          b.order.resize(k);
-        } else {
-          grid.nearest(at, k, b.cand, b.cand_d2);
-          b.cand_pts.resize(k);
-          for (size_t j = 0; j < k; ++j) {
-            b.cand_pts[j] = pts[b.cand[j]];
-            b.order.emplace_back(b.cand_d2[j], static_cast<uint32_t>(j));
-          }
-        }
-        b.row_pts.resize(k);
-        b.row_d2.resize(k);
-        h2 = 0;
-        for (size_t j = 0; j < k; ++j) {
-          b.row_pts[j] = b.cand_pts[b.order[j].second];
-          b.row_d2[j] = b.order[j].first;
-          h2 = std::max(h2, b.order[j].first);
-        }
+      if (b.rows.size() >= k) {
+        takeRows(g.near, b.d2, b.rows, b);
+      } else {
+        // The k nearest by (distance², slot): within reach from the cell's
+        // gathering, else from the wider one, else a search.
+        h2 = selectNearest(b.d2, reach2, k, b.bin, b.part, b.part_d2, b.rows);
+        if (h2 >= 0)
+          takeRows(g.near, b.d2, b.rows, b);
+        else
+          h2 = nearestFromWide(at, k, std::numeric_limits<double>::infinity(), b, g);
       }
-      LocalSurface fit = fitLocal(b.row_pts.data(), b.row_d2.data(), b.row_pts.size(), at, p.polynomial_order, h2);
+      LocalSurface fit = fitPlane(b.row_pts.data(), b.row_d2.data(), b.row_pts.size(), at, h2, b.w);
       if (fit.centroid_offset > kInsideCentroidOffset && k_edge > b.row_pts.size()) {
         // Twice the points lie within about √2 the radius that held k (1.6 leaves room
         // for a density falling off towards the edge); further out only if not.
-        if (!near || !nearestFromWide(at, 2.56 * h2, b, *near)) grid.nearest(at, k_edge, b.cand, b.cand_d2);
-        b.row_pts.resize(k_edge);
-        h2 = 0;
-        for (size_t j = 0; j < k_edge; ++j) {
-          b.row_pts[j] = pts[b.cand[j]];
-          h2 = std::max(h2, b.cand_d2[j]);
-        }
-        fit = fitLocal(b.row_pts.data(), b.cand_d2.data(), k_edge, at, p.polynomial_order, h2);
+        h2 = nearestFromWide(at, k_edge, 2.56 * h2, b, g);
+        fit = fitPlane(b.row_pts.data(), b.row_d2.data(), b.row_pts.size(), at, h2, b.w);
       }
+      if (p.polynomial_order == 2) fitQuadratic(fit, b.row_pts.data(), b.row_pts.size(), b.w);
       *used_radius = static_cast<float>(std::sqrt(h2));
       return fit;
     };
 
+    const size_t cells = grid.cellCount();
+    const std::vector<uint32_t>& cell_start = grid.cellStart();
+    const std::vector<uint32_t>& cell_points = grid.cellPoints();
     std::vector<float> point_radius(pts.size());
     size_t fitted = 0;
     if (p.anchor_ratio == 0 || p.polynomial_order == 1) {
@@ -355,20 +416,26 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
 #pragma omp parallel
       {
         Buffers b;
-#pragma omp for schedule(dynamic, 64)
-        for (long i = 0; i < n; ++i)
-          result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i], nullptr).project(pts[i]);
+        Gathered near;
+#pragma omp for schedule(dynamic, 4)
+        for (long c = 0; c < static_cast<long>(cells); ++c) {
+          const size_t cs = static_cast<size_t>(c);
+          near.gather(grid, cs, reach);
+          for (uint32_t slot = cell_start[cs]; slot < cell_start[cs + 1]; ++slot) {
+            const uint32_t i = cell_points[slot];
+            result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i], near).project(pts[i]);
+          }
+        }
       }
     } else {
       const std::vector<uint32_t> anchors = pickAnchors(pts, std::max(1e-6, p.anchor_ratio * radius));
       std::vector<LocalSurface> surfaces(anchors.size());
       std::vector<float> anchor_radius(anchors.size());
       // Anchors grouped by grid cell (counting sort), fitted cell by cell.
-      const size_t cells = grid.cellCount();
       std::vector<uint32_t> cell_of(pts.size());
       for (size_t c = 0; c < cells; ++c)
-        for (uint32_t slot = grid.cellStart()[c]; slot < grid.cellStart()[c + 1]; ++slot)
-          cell_of[grid.cellPoints()[slot]] = static_cast<uint32_t>(c);
+        for (uint32_t slot = cell_start[c]; slot < cell_start[c + 1]; ++slot)
+          cell_of[cell_points[slot]] = static_cast<uint32_t>(c);
       std::vector<uint32_t> anchor_start(cells + 1, 0), by_cell(anchors.size());
       for (uint32_t i : anchors) ++anchor_start[cell_of[i] + 1];
       for (size_t c = 0; c < cells; ++c) anchor_start[c + 1] += anchor_start[c];
@@ -387,7 +454,7 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
           near.gather(grid, cs, reach);
           for (uint32_t s = anchor_start[cs]; s < anchor_start[cs + 1]; ++s) {
             const uint32_t a = by_cell[s];
-            surfaces[a] = fitAt(pts[anchors[a]], b, &anchor_radius[a], &near);
+            surfaces[a] = fitAt(pts[anchors[a]], b, &anchor_radius[a], near);
           }
         }
       }
@@ -412,8 +479,6 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
       // otherwise (far from every anchor) it searches.
       const double sure = 2.0 * spacing;
       const double gather = (0.5 * std::sqrt(3.0) * grid.cellSize() + sure) * (1 + 1e-9);
-      const std::vector<uint32_t>& cell_start = grid.cellStart();
-      const std::vector<uint32_t>& cell_points = grid.cellPoints();
 #pragma omp parallel
       {
         Buffers b;
@@ -453,7 +518,7 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
               own_fit[i] = 1;
               if (!gathered) near_points.gather(grid, cs, reach);
               gathered = true;
-              result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i], &near_points).project(pts[i]);
+              result.cloud.points[i] = fitAt(pts[i], b, &point_radius[i], near_points).project(pts[i]);
               continue;
             }
             // A distance-weighted blend of the nearest anchors' projections.
