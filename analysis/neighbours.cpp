@@ -364,7 +364,7 @@ void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progr
       // Each cell's points share the candidates of the 27 cells around it: every
       // point within one cell width of any of them.
       std::vector<double> nx, ny, nz, dd;  // candidates' coordinates (vectorisable) and squared distances
-      std::vector<uint32_t> near_idx;
+      std::vector<uint32_t> near_idx, sel;
       std::vector<Candidate> cand;
       std::vector<uint32_t> idx;
       std::vector<double> d2;
@@ -401,15 +401,16 @@ void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progr
           const double sure2 = everything ? std::numeric_limits<double>::infinity() : sure * sure;
           bool done = false;
           for (double limit2 : {std::min(sure2, 0.7 * g.cell * g.cell), sure2}) {
-            // Every candidate written, kept when within the limit: no branch to mispredict.
-            cand.resize(m);
+            // Every slot written, kept when within the limit: no branch to mispredict.
+            sel.resize(m);
             size_t within = 0;
             for (size_t j = 0; j < m; ++j) {
-              cand[within] = {dd[j], near_idx[j]};
+              sel[within] = static_cast<uint32_t>(j);
               within += dd[j] <= limit2 ? 1 : 0;
             }
-            cand.resize(within);
-            if (cand.size() >= k) {
+            if (within >= k) {
+              cand.resize(within);
+              for (size_t j = 0; j < within; ++j) cand[j] = {dd[sel[j]], near_idx[sel[j]]};
               keepNearest(cand, k);
               done = true;
               break;
@@ -563,6 +564,51 @@ Eigen::Vector3i voxelOf(const Vec3& p, double size) {
 int64_t voxelKey(const Eigen::Vector3i& c) {
   return (static_cast<int64_t>(c.x()) * 73856093) ^ (static_cast<int64_t>(c.y()) * 19349663) ^
          (static_cast<int64_t>(c.z()) * 83492791);
+}
+
+namespace {
+constexpr uint32_t kFree = std::numeric_limits<uint32_t>::max();
+int shiftFor(size_t slots) { return 64 - static_cast<int>(std::lround(std::log2(static_cast<double>(slots)))); }
+}  // namespace
+
+KeyIds::KeyIds(size_t expected_keys) {
+  size_t slots = 16;
+  while (slots < 2 * expected_keys) slots *= 2;
+  key_.assign(slots, 0);
+  id_.assign(slots, kFree);
+  shift_ = shiftFor(slots);
+}
+
+uint32_t KeyIds::idOf(int64_t key) {
+  const size_t mask = key_.size() - 1;
+  for (size_t s = (static_cast<uint64_t>(key) * 0x9E3779B97F4A7C15ull) >> shift_;; s = (s + 1) & mask) {
+    if (id_[s] == kFree) {
+      key_[s] = key;
+      id_[s] = static_cast<uint32_t>(ids_++);
+      const uint32_t id = id_[s];
+      if (2 * ids_ > key_.size()) grow();  // at most half full: short probe runs
+      return id;
+    }
+    if (key_[s] == key) return id_[s];
+  }
+}
+
+void KeyIds::grow() {
+  std::vector<int64_t> old_key;
+  std::vector<uint32_t> old_id;
+  old_key.swap(key_);
+  old_id.swap(id_);
+  key_.assign(2 * old_key.size(), 0);
+  id_.assign(2 * old_key.size(), kFree);
+  shift_ = shiftFor(key_.size());
+  const size_t mask = key_.size() - 1;
+  for (size_t o = 0; o < old_key.size(); ++o) {
+    if (old_id[o] == kFree) continue;
+    size_t s = (static_cast<uint64_t>(old_key[o]) * 0x9E3779B97F4A7C15ull) >> shift_;
+    while (id_[s] != kFree) s = (s + 1) & mask;
+    key_[s] = old_key[o];
+    id_[s] = old_id[o];
+  }
 }
 
 }  // namespace sailshape

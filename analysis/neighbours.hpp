@@ -115,4 +115,22 @@ Eigen::Vector3i voxelOf(const Vec3& p, double size);
 int64_t voxelKey(const Eigen::Vector3i& cell);
 inline int64_t voxelKey(const Vec3& p, double size) { return voxelKey(voxelOf(p, size)); }
 
+// Dense ids 0, 1, 2, ... for int64 keys (voxel keys) in the order they are first
+// seen: an open-addressing table, several times faster than std::unordered_map
+// for the hundreds of thousands of keys of a cloud.
+class KeyIds {
+ public:
+  explicit KeyIds(size_t expected_keys = 16);
+  // The key's id; a key not seen before gets the next id (size() before the call).
+  uint32_t idOf(int64_t key);
+  size_t size() const { return ids_; }
+
+ private:
+  void grow();
+  std::vector<int64_t> key_;
+  std::vector<uint32_t> id_;  // kFree where no key is stored
+  size_t ids_ = 0;
+  int shift_ = 60;
+};
+
 }  // namespace sailshape

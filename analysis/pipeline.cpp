@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
 #include "analysis/errors.hpp"
 
@@ -42,20 +41,19 @@ VoxelSample voxelSample(const Cloud& in, double voxel) {
   VoxelSample out;
   out.cloud.viewpoint = in.viewpoint;
   out.voxel_of.resize(in.size());
-  std::unordered_map<int64_t, uint32_t> index;
-  index.reserve(in.size() / 2 + 1);
+  KeyIds index(in.size() / 4);
   std::vector<Vec3> sum;
   std::vector<uint32_t> count;
   for (size_t i = 0; i < in.size(); ++i) {
     const Vec3& p = in.points[i];
-    auto [it, fresh] = index.emplace(voxelKey(p, voxel), static_cast<uint32_t>(sum.size()));
-    if (fresh) {
+    const uint32_t v = index.idOf(voxelKey(p, voxel));
+    if (v == sum.size()) {
       sum.push_back(Vec3::Zero());
       count.push_back(0);
     }
-    sum[it->second] += p;
-    ++count[it->second];
-    out.voxel_of[i] = it->second;
+    sum[v] += p;
+    ++count[v];
+    out.voxel_of[i] = v;
   }
   out.cloud.points.resize(sum.size());
   for (size_t v = 0; v < sum.size(); ++v) out.cloud.points[v] = sum[v] / static_cast<double>(count[v]);

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
+#include <memory>
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
@@ -192,33 +192,32 @@ constexpr double kInsideRadius = 1.25;
 
 // One anchor per cubic cell of side `cell`: the point nearest the cell's centroid.
 std::vector<uint32_t> pickAnchors(const std::vector<Vec3>& pts, double cell) {
-  struct Acc {
-    Vec3 sum = Vec3::Zero();
-    uint32_t count = 0, best = 0;
-    double best_d2 = 0;
-  };
-  auto key = [cell](const Vec3& p) { return voxelKey(p, cell); };
-  std::unordered_map<int64_t, Acc> cells;
-  cells.reserve(pts.size() / 4 + 1);
-  for (const Vec3& p : pts) {
-    Acc& a = cells[key(p)];
-    a.sum += p;
-    ++a.count;
+  KeyIds ids(pts.size() / 4);
+  std::vector<uint32_t> cell_of(pts.size());
+  std::vector<Vec3> sum;
+  std::vector<uint32_t> count;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const uint32_t c = ids.idOf(voxelKey(pts[i], cell));
+    if (c == sum.size()) {
+      sum.push_back(Vec3::Zero());
+      count.push_back(0);
+    }
+    sum[c] += pts[i];
+    ++count[c];
+    cell_of[i] = c;
   }
-  for (auto& [k, a] : cells) a.best_d2 = std::numeric_limits<double>::infinity();
+  std::vector<uint32_t> best(sum.size(), 0);
+  std::vector<double> best_d2(sum.size(), std::numeric_limits<double>::infinity());
   for (uint32_t i = 0; i < pts.size(); ++i) {
-    Acc& a = cells[key(pts[i])];
-    const double d2 = (pts[i] - a.sum / a.count).squaredNorm();
-    if (d2 < a.best_d2) {
-      a.best_d2 = d2;
-      a.best = i;
+    const uint32_t c = cell_of[i];
+    const double d2 = (pts[i] - sum[c] / count[c]).squaredNorm();
+    if (d2 < best_d2[c]) {
+      best_d2[c] = d2;
+      best[c] = i;
     }
   }
-  std::vector<uint32_t> anchors;
-  anchors.reserve(cells.size());
-  for (const auto& [k, a] : cells) anchors.push_back(a.best);
-  std::sort(anchors.begin(), anchors.end());
-  return anchors;
+  std::sort(best.begin(), best.end());
+  return best;
 }
 
 }  // namespace
@@ -248,12 +247,14 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
 
   {
     // The neighbourhood radius: the median k-th neighbour distance over a sample of points.
-    double radius = std::max(1e-6, medianNeighbourDistance(*gridForNeighbours(pts, k), pts, k, 256));
+    // One grid serves both medians: its searches are exact at any cell width.
+    const std::unique_ptr<PointGrid> median_grid = gridForNeighbours(pts, k);
+    double radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
     const double density = static_cast<double>(k) / (M_PI * radius * radius);  // points/m² on the surface
     if (p.reference_density_per_m2 > 0 && density > p.reference_density_per_m2) {
       k = std::min(pts.size(), static_cast<size_t>(std::lround(static_cast<double>(k) *
                                                                std::sqrt(density / p.reference_density_per_m2))));
-      radius = std::max(1e-6, medianNeighbourDistance(*gridForNeighbours(pts, k), pts, k, 256));
+      radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
     }
     result.k_used = k;
     // Gathered from a grid a little wider than the radius, so the k nearest of

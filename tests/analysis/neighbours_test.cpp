@@ -415,5 +415,24 @@ TEST(MedianSpacing, IsZeroWithoutASecondColumnOrPoint) {
   EXPECT_EQ(medianSpacing(NeighbourTable{}), 0.0);
 }
 
+TEST(KeyIds, NumbersKeysInTheOrderFirstSeenAndKeepsThemWhileGrowing) {
+  // Starts small (16 slots) and grows many times over 10,000 keys, negative and
+  // colliding-prone (multiples of a large power of two) among them.
+  KeyIds ids(1);
+  std::vector<int64_t> keys;
+  for (int64_t i = 0; i < 10000; ++i) keys.push_back((i % 2 ? -1 : 1) * (i << 40) + i);
+  for (size_t i = 0; i < keys.size(); ++i) {
+    EXPECT_EQ(ids.idOf(keys[i]), i);
+    EXPECT_EQ(ids.size(), i + 1);
+  }
+  for (size_t i = 0; i < keys.size(); i += 7) EXPECT_EQ(ids.idOf(keys[i]), i);
+  EXPECT_EQ(ids.size(), keys.size());
+  // The voxel keys of points in the same cube share an id.
+  KeyIds voxels;
+  const uint32_t a = voxels.idOf(voxelKey(Vec3(0.01, 0.02, 0.03), 0.1));
+  EXPECT_EQ(voxels.idOf(voxelKey(Vec3(0.09, 0.08, 0.07), 0.1)), a);
+  EXPECT_EQ(voxels.idOf(voxelKey(Vec3(0.11, 0.02, 0.03), 0.1)), a + 1);
+}
+
 }  // namespace
 }  // namespace sailshape
