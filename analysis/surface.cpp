@@ -2,6 +2,7 @@
 
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include <Eigen/Eigenvalues>
@@ -16,8 +17,11 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<uint32_t, Kernel>;
-using Tds = CGAL::Triangulation_data_structure_2<VertexBase>;
+// Each face keeps its triangle's index (kNoTriangle for slivers) for the component search.
+using FaceBase = CGAL::Triangulation_face_base_with_info_2<uint32_t, Kernel>;
+using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
 using Delaunay = CGAL::Delaunay_triangulation_2<Kernel, Tds>;
+constexpr uint32_t kNoTriangle = std::numeric_limits<uint32_t>::max();
 
 std::vector<std::pair<Kernel::Point_2, uint32_t>> projectToPlane(const Cloud& cloud) {
   Vec3 mean = Vec3::Zero();
@@ -44,39 +48,28 @@ std::vector<std::pair<Kernel::Point_2, uint32_t>> projectToScanAngles(const Clou
   return pts;
 }
 
-// Keeps the triangles of the largest edge-connected component (ties: the one
-// holding the lowest triangle). Triangles sharing an edge are found by bucketing
-// each edge under its lower vertex (counting sort: linear in the mesh).
-size_t keepLargestComponent(std::vector<std::array<uint32_t, 3>>& tris, size_t vertices) {
-  struct Half {
-    uint32_t other, tri;
-  };
-  std::vector<uint32_t> start(vertices + 1, 0);
-  for (const auto& t : tris)
-    for (int e = 0; e < 3; ++e) ++start[std::min(t[e], t[(e + 1) % 3]) + 1];
-  for (size_t v = 0; v < vertices; ++v) start[v + 1] += start[v];
-  std::vector<Half> halves(start[vertices]);
-  {
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-    for (uint32_t t = 0; t < tris.size(); ++t)
-      for (int e = 0; e < 3; ++e) {
-        const uint32_t a = tris[t][e], b = tris[t][(e + 1) % 3];
-        halves[fill[std::min(a, b)]++] = {std::max(a, b), t};
-      }
-  }
+// Keeps the triangles of the largest edge-connected component of `kept` (ties: the
+// one holding the lowest triangle). Triangles sharing an edge are neighbouring faces
+// of the triangulation: face f holds triangle f->info() of the Delaunay list, kept
+// as slot[f->info()] (kNoTriangle: dropped).
+size_t keepLargestComponent(const Delaunay& dt, const std::vector<uint32_t>& slot,
+                            std::vector<std::array<uint32_t, 3>>& tris) {
   std::vector<uint32_t> parent(tris.size());
   std::iota(parent.begin(), parent.end(), 0u);
   auto find = [&](uint32_t x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
-  for (size_t v = 0; v < vertices; ++v)
-    for (uint32_t i = start[v]; i < start[v + 1]; ++i)
-      for (uint32_t j = start[v]; j < i; ++j)
-        if (halves[j].other == halves[i].other) {
-          parent[find(halves[i].tri)] = find(halves[j].tri);
-          break;
-        }
+  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
+    const uint32_t t = f->info();
+    if (t == kNoTriangle || slot[t] == kNoTriangle) continue;
+    for (int e = 0; e < 3; ++e) {
+      const auto nb = f->neighbor(e);
+      if (dt.is_infinite(nb)) continue;
+      const uint32_t u = nb->info();
+      if (u < t && slot[u] != kNoTriangle) parent[find(slot[t])] = find(slot[u]);
+    }
+  }
   std::vector<uint32_t> count(tris.size(), 0);
   std::vector<uint32_t> root(tris.size());
   for (uint32_t t = 0; t < tris.size(); ++t) ++count[root[t] = find(t)];
@@ -92,6 +85,29 @@ size_t keepLargestComponent(std::vector<std::array<uint32_t, 3>>& tris, size_t v
   const size_t dropped = tris.size() - kept.size();
   tris.swap(kept);
   return dropped;
+}
+
+// The (n/2)-th smallest of the non-negative values v (what nth_element puts at n/2),
+// from a histogram of 4,096 bins and a selection within the one bin that holds it.
+double medianOf(const std::vector<double>& v) {
+  double hi = 0;
+  for (double x : v) hi = std::max(hi, x);
+  if (!(hi > 0)) return hi;
+  constexpr int kBins = 4096;
+  const double scale = kBins / hi;
+  auto binOf = [&](double x) { return std::min(kBins - 1, static_cast<int>(x * scale)); };
+  std::vector<uint32_t> count(kBins, 0);
+  for (double x : v) ++count[static_cast<size_t>(binOf(x))];
+  const size_t want = v.size() / 2;
+  size_t below = 0;
+  int b = 0;
+  while (below + count[static_cast<size_t>(b)] <= want) below += count[static_cast<size_t>(b++)];
+  std::vector<double> part;
+  part.reserve(count[static_cast<size_t>(b)]);
+  for (double x : v)
+    if (binOf(x) == b) part.push_back(x);
+  std::nth_element(part.begin(), part.begin() + static_cast<long>(want - below), part.end());
+  return part[want - below];
 }
 
 }  // namespace
@@ -125,6 +141,7 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
   std::vector<double> edge_len;
   edge_len.reserve(static_cast<size_t>(dt.number_of_faces()) * 3);
   for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
+    f->info() = kNoTriangle;
     // Points that should be collinear (a straight boundary of a regular scan) come out of
     // the projection a rounding error apart, and the triangulation joins them into
     // zero-area slivers along the hull: no surface, no normal. Skip faces whose height is
@@ -135,6 +152,7 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
                                       CGAL::squared_distance(c, a)});
     if (twice_area <= 1e-9 * longest2) continue;
     std::array<uint32_t, 3> t{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
+    f->info() = static_cast<uint32_t>(tris.size());
     tris.push_back(t);
     for (int e = 0; e < 3; ++e) edge_len.push_back((cloud.points[t[e]] - cloud.points[t[(e + 1) % 3]]).norm());
   }
@@ -142,24 +160,23 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
   if (tris.empty()) throw AnalysisError("[reconstructSurface] the points are collinear in the projection: no triangle");
 
   double max_edge = p.max_edge_m;
-  if (max_edge == 0) {
-    std::vector<double> sorted = edge_len;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    max_edge = p.max_edge_factor * sorted[sorted.size() / 2];
-  }
+  if (max_edge == 0) max_edge = p.max_edge_factor * medianOf(edge_len);
   result.max_edge_m = max_edge;
   std::vector<std::array<uint32_t, 3>> kept;
   kept.reserve(tris.size());
+  std::vector<uint32_t> slot(tris.size(), kNoTriangle);  // triangle -> its place in `kept`
   for (size_t t = 0; t < tris.size(); ++t) {
-    if (edge_len[3 * t] > max_edge || edge_len[3 * t + 1] > max_edge || edge_len[3 * t + 2] > max_edge)
+    if (edge_len[3 * t] > max_edge || edge_len[3 * t + 1] > max_edge || edge_len[3 * t + 2] > max_edge) {
       ++result.dropped_long_edges;
-    else
+    } else {
+      slot[t] = static_cast<uint32_t>(kept.size());
       kept.push_back(tris[t]);
+    }
   }
   if (kept.empty())
     throw AnalysisError("[reconstructSurface] every triangle has an edge longer than max_edge_m = " +
                         std::to_string(max_edge) + " m");
-  if (p.largest_component_only) result.dropped_small_components = keepLargestComponent(kept, cloud.size());
+  if (p.largest_component_only) result.dropped_small_components = keepLargestComponent(dt, slot, kept);
 
   // Compact: mesh vertices are the used input points, in input order.
   std::vector<uint32_t> remap(cloud.size(), std::numeric_limits<uint32_t>::max());
