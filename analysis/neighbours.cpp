@@ -73,6 +73,34 @@ void keepNearest(std::vector<Candidate>& cand, size_t k) {
   std::sort(cand.begin(), cand.begin() + static_cast<long>(k));
 }
 
+// The candidates at slots sel[0 .. n) (squared distances dd, all <= limit2, and
+// indices idx) into `cand`, sorted by (distance², index): a counting sort into 64
+// bins of limit2 / 64 (a surface's squared distances spread evenly over them),
+// then an insertion sort that only mends each bin's order. For the few dozen
+// candidates of a table row, several times cheaper than nth_element and sort.
+// Needs a finite limit2 (and n small: the insertion sort is quadratic within a bin).
+void sortWithin(const std::vector<double>& dd, const std::vector<uint32_t>& idx, const std::vector<uint32_t>& sel,
+                size_t n, double limit2, std::vector<Candidate>& cand) {
+  constexpr int kBins = 64;
+  const double scale = limit2 > 0 ? kBins / limit2 : 0.0;
+  uint32_t start[kBins + 1] = {};
+  thread_local std::vector<uint8_t> bin;
+  bin.resize(n);
+  for (size_t j = 0; j < n; ++j) {
+    bin[j] = static_cast<uint8_t>(std::min(kBins - 1, static_cast<int>(dd[sel[j]] * scale)));
+    ++start[bin[j] + 1];
+  }
+  for (int b = 0; b < kBins; ++b) start[b + 1] += start[b];
+  cand.resize(n);
+  for (size_t j = 0; j < n; ++j) cand[start[bin[j]]++] = {dd[sel[j]], idx[sel[j]]};
+  for (size_t j = 1; j < n; ++j) {
+    const Candidate c = cand[j];
+    size_t i = j;
+    for (; i > 0 && c < cand[i - 1]; --i) cand[i] = cand[i - 1];
+    cand[i] = c;
+  }
+}
+
 // Writes the first k candidates as point i's row, the point itself first: duplicate
 // points (distance 0, lower index) can push it out of the k or off slot 0.
 void writeRow(const std::vector<Candidate>& cand, size_t k, uint32_t i, uint32_t* row, float* row_d2) {
@@ -407,6 +435,11 @@ void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progr
             for (size_t j = 0; j < m; ++j) {
               sel[within] = static_cast<uint32_t>(j);
               within += dd[j] <= limit2 ? 1 : 0;
+            }
+            if (within >= k && within <= 1024 && std::isfinite(limit2)) {
+              sortWithin(dd, near_idx, sel, within, limit2, cand);
+              done = true;
+              break;
             }
             if (within >= k) {
               cand.resize(within);
