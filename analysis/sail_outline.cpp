@@ -196,34 +196,57 @@ struct Edge {
 // the edge spoils only its own window) exceeds the mean of such gaps' estimates
 // by (1 − ln 2) of a mean gap; that is taken off.
 struct Frontier {
-  double recess = 0, sigma = 0;  // m
+  double recess = 0, sigma = 0;       // m
   size_t windows = 0;
+  std::vector<double> centre, local;  // each window's mid arc position and recess estimate, m
+  double median = 0;                  // of `local`, m
+  double mean_gap = 0;                // m
 };
 
 Frontier frontierRecess(std::vector<std::pair<double, double>> along_offset, double D, double window) {
   std::sort(along_offset.begin(), along_offset.end());
   Frontier f;
-  std::vector<double> deltas;
-  double gap_sum = 0;
+  struct Window {
+    double centre, span, least;
+    size_t n;
+  };
+  std::vector<Window> windows;
   for (size_t a = 0; a < along_offset.size();) {
     size_t b = a;
     double least = std::numeric_limits<double>::infinity();
     while (b < along_offset.size() && along_offset[b].first < along_offset[a].first + window)
       least = std::min(least, along_offset[b++].second);
-    if (b - a >= 8) {
-      // −least = δ − gap + E[gap], E[gap] = (D + δ)/(n + 1): solved for δ.
-      const double q = 1.0 / (static_cast<double>(b - a) + 1);
-      deltas.push_back((q * D - least) / (1.0 - q));
-      gap_sum += q * (D + std::max(deltas.back(), 0.0));
-    }
+    if (b - a >= 8)
+      windows.push_back({0.5 * (along_offset[a].first + along_offset[b - 1].first),
+                         along_offset[b - 1].first - along_offset[a].first, least, b - a});
     a = b;
+  }
+  if (windows.empty()) return f;
+  // Samples per full window: the median count (near a narrow corner the strip
+  // reaches across the sail and holds fewer, though the outermost lies as close).
+  std::vector<size_t> counts;
+  for (const Window& w : windows) counts.push_back(w.n);
+  std::nth_element(counts.begin(), counts.begin() + static_cast<long>(counts.size() / 2), counts.end());
+  const double n_full = static_cast<double>(counts[counts.size() / 2]);
+  std::vector<double> deltas;
+  double gap_sum = 0;
+  for (const Window& w : windows) {
+    // −least = δ − gap + E[gap], E[gap] = (D + δ)/(n + 1): solved for δ.
+    const double n = std::max(1.0, n_full * std::min(1.0, w.span / window));
+    const double q = 1.0 / (n + 1);
+    deltas.push_back((q * D - w.least) / (1.0 - q));
+    gap_sum += q * (D + std::max(deltas.back(), 0.0));
+    f.centre.push_back(w.centre);
+    f.local.push_back(deltas.back());
   }
   f.windows = deltas.size();
   if (deltas.empty()) return f;
   const double n = static_cast<double>(deltas.size());
   const double mean_gap = gap_sum / n;
+  f.mean_gap = mean_gap;
   std::nth_element(deltas.begin(), deltas.begin() + static_cast<long>(deltas.size() / 2), deltas.end());
-  f.recess = deltas[deltas.size() / 2] - (1.0 - std::log(2.0)) * mean_gap;
+  f.median = deltas[deltas.size() / 2];
+  f.recess = f.median - (1.0 - std::log(2.0)) * mean_gap;
   // An exponential gap's spread equals its mean; a median spreads about 1.25x a mean's.
   f.sigma = 1.25 * mean_gap / std::sqrt(n);
   return f;
@@ -305,6 +328,7 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
   }
   // δ's σ: offsets spread over about the strip width, uniform.
   double sigma_recess = strip / std::sqrt(3.0);
+  Frontier frontier;
   if (count >= 30) {
     e.recess = std::clamp(strip - 2.0 * sum / static_cast<double>(count), 0.0, strip);
     sigma_recess = 2.0 * strip / std::sqrt(12.0 * static_cast<double>(count));
@@ -315,13 +339,42 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
     // millimetre there): estimates from those are several times sharper. They
     // also hold after smoothing, which pulls a noisy scan's outermost samples in
     // less than the samples behind them (the mean came out 3-6 mm short there).
-    const Frontier f = frontierRecess(along_offset, strip, 10.0 * spacing);
-    if (f.windows >= 3) {
-      e.recess = std::clamp(f.recess, 0.0, strip);
-      sigma_recess = f.sigma;
+    frontier = frontierRecess(along_offset, strip, 5.0 * spacing);
+    if (frontier.windows >= 6) {
+      e.recess = std::clamp(frontier.recess, 0.0, strip);
+      sigma_recess = frontier.sigma;
     }
   }
-  if (e.recess > 0) {
+  if (frontier.windows >= 6) {
+    // The recess along the edge: a polynomial of the curve's degree (at most a
+    // third as many coefficients as windows) through the windows' estimates, each
+    // held within 4 mean gaps of their median (a stray beyond the edge). It takes
+    // out the curve's own wiggles, which a least-squares fit through boundary
+    // samples scattered by one gap each leaves at 3-5 mm on a gennaker's luff.
+    const size_t m = frontier.local.size();
+    const int deg = std::min(degree, static_cast<int>(m / 3) - 1);
+    const double lo = frontier.centre.front(), hi = frontier.centre.back();
+    const double mid = 0.5 * (lo + hi), half = std::max(1e-9, 0.5 * (hi - lo));
+    Eigen::MatrixXd A(static_cast<Eigen::Index>(m), deg + 1);
+    Eigen::VectorXd y(static_cast<Eigen::Index>(m));
+    for (size_t j = 0; j < m; ++j) {
+      const double u = (frontier.centre[j] - mid) / half;
+      double uk = 1;
+      for (int k = 0; k <= deg; ++k, uk *= u) A(static_cast<Eigen::Index>(j), k) = uk;
+      y[static_cast<Eigen::Index>(j)] =
+          std::clamp(frontier.local[j], frontier.median - 4.0 * frontier.mean_gap,
+                     frontier.median + 4.0 * frontier.mean_gap);
+    }
+    const Eigen::VectorXd c = A.colPivHouseholderQr().solve(y);
+    for (size_t i = 0; i < e.points.size(); ++i) {
+      const double u = std::clamp((e.s[i] - mid) / half, -1.0, 1.0);  // held at the end windows' value beyond them
+      double uk = 1, d = 0;
+      for (int k = 0; k <= deg; ++k, uk *= u) d += c[k] * uk;
+      e.points[i] -= std::clamp(d, 0.0, strip) * inward[i];
+    }
+    sigma_recess = frontier.mean_gap * std::sqrt(static_cast<double>(deg + 1) / static_cast<double>(m));
+    fit();
+  } else if (e.recess > 0) {
     for (size_t i = 0; i < e.points.size(); ++i) e.points[i] -= e.recess * inward[i];
     fit();
   }
