@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 
@@ -43,18 +44,60 @@ inline double expWeight(double x) {
   return e * e;
 }
 
-// The weighted plane through the neighbours `nb` (squared distances d2 from the
-// point `at`, none beyond the radius² h2) of the point `at`; their weights go to w.
-LocalSurface fitPlane(const Vec3* nb, const double* d2, size_t k, const Vec3& at, double h2, std::vector<double>& w) {
+// The fits' sums run over pairs of rows at once (two lanes of a 16-byte vector,
+// plain SSE2), each lane summing every other row: the same result every run.
+typedef double Lanes __attribute__((vector_size(16)));
+inline Lanes load2(const double* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline Lanes both(double x) { return Lanes{x, x}; }
+inline double sum(Lanes v) { return v[0] + v[1]; }
+
+// A fit's rows: coordinates apart (x, y, z) and their squared distances from the fitted point.
+struct Rows {
+  std::vector<double> x, y, z, d2;
+  size_t size() const { return x.size(); }
+  void resize(size_t n) {
+    x.resize(n);
+    y.resize(n);
+    z.resize(n);
+    d2.resize(n);
+  }
+};
+
+// The weighted plane through the rows `r` (none beyond the radius² h2) around the
+// point `at`; their weights go to w.
+LocalSurface fitPlane(const Rows& r, const Vec3& at, double h2, std::vector<double>& w) {
   LocalSurface s;
+  const size_t k = r.size();
   h2 = std::max(1e-12, h2);
   w.resize(k);
   const double g = -2.0 / h2;  // the radius is 2σ of the weights
-  for (size_t j = 0; j < k; ++j) w[j] = expWeight(std::max(-2.0, g * d2[j]));
+  for (size_t j = 0; j < k; ++j) w[j] = expWeight(std::max(-2.0, g * r.d2[j]));
   // Moments about `at` (small numbers: no cancellation in the covariance).
-  double sw = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
-  for (size_t j = 0; j < k; ++j) {
-    const double x = nb[j].x() - at.x(), y = nb[j].y() - at.y(), z = nb[j].z() - at.z(), wj = w[j];
+  const Lanes ax = both(at.x()), ay = both(at.y()), az = both(at.z());
+  Lanes vw = both(0), vx = vw, vy = vw, vz = vw, vxx = vw, vxy = vw, vxz = vw, vyy = vw, vyz = vw, vzz = vw;
+  size_t j = 0;
+  for (; j + 2 <= k; j += 2) {
+    const Lanes x = load2(&r.x[j]) - ax, y = load2(&r.y[j]) - ay, z = load2(&r.z[j]) - az, wj = load2(&w[j]);
+    const Lanes wx = wj * x, wy = wj * y, wz = wj * z;
+    vw += wj;
+    vx += wx;
+    vy += wy;
+    vz += wz;
+    vxx += wx * x;
+    vxy += wx * y;
+    vxz += wx * z;
+    vyy += wy * y;
+    vyz += wy * z;
+    vzz += wz * z;
+  }
+  double sw = sum(vw), sx = sum(vx), sy = sum(vy), sz = sum(vz), sxx = sum(vxx), sxy = sum(vxy), sxz = sum(vxz),
+         syy = sum(vyy), syz = sum(vyz), szz = sum(vzz);
+  for (; j < k; ++j) {
+    const double x = r.x[j] - at.x(), y = r.y[j] - at.y(), z = r.z[j] - at.z(), wj = w[j];
     sw += wj;
     sx += wj * x;
     sy += wj * y;
@@ -87,46 +130,65 @@ LocalSurface fitPlane(const Vec3* nb, const double* d2, size_t k, const Vec3& at
 }
 
 // The weighted quadratic height field over the plane `s` (from fitPlane, with the
-// same neighbours and their weights w).
-void fitQuadratic(LocalSurface& s, const Vec3* nb, size_t k, const std::vector<double>& w) {
+// same rows and their weights w).
+void fitQuadratic(LocalSurface& s, const Rows& r, const std::vector<double>& w) {
   // The normal equations need the weighted moments of u^a v^b up to a + b = 4
-  // and of z u^a v^b up to a + b = 2.
-  double M[15] = {}, Z[6] = {};
+  // and of z u^a v^b up to a + b = 2: M[0..14] and Z[0..5] below.
+  const size_t k = r.size();
   const Vec3 eu = s.eu * s.scale, ev = s.ev * s.scale;
-  for (size_t j = 0; j < k; ++j) {
-    const Vec3 d = nb[j] - s.origin;
-    const double u = d.dot(eu), v = d.dot(ev), z = d.dot(s.normal), wj = w[j];
-    const double uu = u * u, uv = u * v, vv = v * v;
-    const double wu = wj * u, wv = wj * v, wuu = wj * uu, wuv = wj * uv, wvv = wj * vv;
-    M[0] += wj;
-    M[1] += wu;
-    M[2] += wv;
-    M[3] += wuu;
-    M[4] += wuv;
-    M[5] += wvv;
-    M[6] += wuu * u;   // u³
-    M[7] += wuu * v;   // u²v
-    M[8] += wvv * u;   // uv²
-    M[9] += wvv * v;   // v³
-    M[10] += wuu * uu;  // u⁴
-    M[11] += wuu * uv;  // u³v
-    M[12] += wuu * vv;  // u²v²
-    M[13] += wuv * vv;  // uv³
-    M[14] += wvv * vv;  // v⁴
-    Z[0] += wj * z;
-    Z[1] += wu * z;
-    Z[2] += wv * z;
-    Z[3] += wuu * z;
-    Z[4] += wuv * z;
-    Z[5] += wvv * z;
+  Lanes L[21];
+  for (Lanes& l : L) l = both(0);
+  auto add = [&](Lanes wj, Lanes u, Lanes v, Lanes z) {
+    const Lanes uu = u * u, uv = u * v, vv = v * v;
+    const Lanes wu = wj * u, wv = wj * v, wuu = wj * uu, wuv = wj * uv, wvv = wj * vv;
+    L[0] += wj;
+    L[1] += wu;
+    L[2] += wv;
+    L[3] += wuu;
+    L[4] += wuv;
+    L[5] += wvv;
+    L[6] += wuu * u;    // u³
+    L[7] += wuu * v;    // u²v
+    L[8] += wvv * u;    // uv²
+    L[9] += wvv * v;    // v³
+    L[10] += wuu * uu;  // u⁴
+    L[11] += wuu * uv;  // u³v
+    L[12] += wuu * vv;  // u²v²
+    L[13] += wuv * vv;  // uv³
+    L[14] += wvv * vv;  // v⁴
+    L[15] += wj * z;
+    L[16] += wu * z;
+    L[17] += wv * z;
+    L[18] += wuu * z;
+    L[19] += wuv * z;
+    L[20] += wvv * z;
+  };
+  const Lanes ox = both(s.origin.x()), oy = both(s.origin.y()), oz = both(s.origin.z());
+  const Lanes eux = both(eu.x()), euy = both(eu.y()), euz = both(eu.z());
+  const Lanes evx = both(ev.x()), evy = both(ev.y()), evz = both(ev.z());
+  const Lanes nx = both(s.normal.x()), ny = both(s.normal.y()), nz = both(s.normal.z());
+  size_t j = 0;
+  for (; j + 2 <= k; j += 2) {
+    const Lanes dx = load2(&r.x[j]) - ox, dy = load2(&r.y[j]) - oy, dz = load2(&r.z[j]) - oz;
+    add(load2(&w[j]), dx * eux + dy * euy + dz * euz, dx * evx + dy * evy + dz * evz, dx * nx + dy * ny + dz * nz);
+  }
+  double M[21];
+  for (int i = 0; i < 21; ++i) M[i] = sum(L[i]);
+  if (j < k) {  // the odd row in lane 0 of a last pass
+    for (Lanes& l : L) l = both(0);
+    const double dx = r.x[j] - s.origin.x(), dy = r.y[j] - s.origin.y(), dz = r.z[j] - s.origin.z();
+    add(Lanes{w[j], 0}, Lanes{dx * eu.x() + dy * eu.y() + dz * eu.z(), 0},
+        Lanes{dx * ev.x() + dy * ev.y() + dz * ev.z(), 0},
+        Lanes{dx * s.normal.x() + dy * s.normal.y() + dz * s.normal.z(), 0});
+    for (int i = 0; i < 21; ++i) M[i] += L[i][0];
   }
   // Basis 1, u, v, u², uv, v²: entry (i, j) is the moment of basis_i · basis_j.
   const int idx[6][6] = {{0, 1, 2, 3, 4, 5},   {1, 3, 4, 6, 7, 8},    {2, 4, 5, 7, 8, 9},
                          {3, 6, 7, 10, 11, 12}, {4, 7, 8, 11, 12, 13}, {5, 8, 9, 12, 13, 14}};
   Eigen::Matrix<double, 6, 6> A;
   for (int i = 0; i < 6; ++i)
-    for (int j = 0; j < 6; ++j) A(i, j) = M[idx[i][j]];
-  const Eigen::Matrix<double, 6, 1> b = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(Z);
+    for (int c = 0; c < 6; ++c) A(i, c) = M[idx[i][c]];
+  const Eigen::Matrix<double, 6, 1> b = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(M + 15);
   Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(A);
   const Eigen::Matrix<double, 6, 1> c = ldlt.solve(b);
   if (ldlt.info() == Eigen::Success && c.allFinite()) s.c = c;
@@ -321,7 +383,6 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
         for (size_t j = 0; j < m; ++j)
           out[j] = (px[j] - ax) * (px[j] - ax) + (py[j] - ay) * (py[j] - ay) + (pz[j] - az) * (pz[j] - az);
       }
-      Vec3 at(size_t j) const { return Vec3(x[j], y[j], z[j]); }
     };
     struct Gathered {
       size_t cell = 0;
@@ -339,10 +400,10 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
       }
     };
     struct Buffers {
-      std::vector<double> d2, part_d2, row_d2;
+      std::vector<double> d2, part_d2;
       std::vector<uint32_t> part, rows, idx;
       std::vector<uint8_t> bin;
-      std::vector<Vec3> row_pts;
+      Rows rows_fit;
       std::vector<double> w;
     };
     const double wide_reach = 2.0 * reach;
@@ -362,20 +423,26 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
     // Rows (points and distance²) of the slots `rows` of gathering `from`.
     auto takeRows = [](const Soa& from, const std::vector<double>& d2, const std::vector<uint32_t>& rows,
                        Buffers& b) {
-      b.row_pts.resize(rows.size());
-      b.row_d2.resize(rows.size());
+      b.rows_fit.resize(rows.size());
       for (size_t j = 0; j < rows.size(); ++j) {
-        b.row_pts[j] = from.at(rows[j]);
-        b.row_d2[j] = d2[rows[j]];
+        b.rows_fit.x[j] = from.x[rows[j]];
+        b.rows_fit.y[j] = from.y[rows[j]];
+        b.rows_fit.z[j] = from.z[rows[j]];
+        b.rows_fit.d2[j] = d2[rows[j]];
       }
     };
     // Rows from a search of the grid (the gathering did not hold enough): the n
     // nearest sorted by (distance², index); returns the n-th distance².
     auto nearestRows = [&](const Vec3& at, size_t count, Buffers& b) {
-      grid.nearest(at, count, b.idx, b.row_d2);
-      b.row_pts.resize(b.idx.size());
-      for (size_t j = 0; j < b.idx.size(); ++j) b.row_pts[j] = pts[b.idx[j]];
-      return b.row_d2.back();
+      grid.nearest(at, count, b.idx, b.part_d2);
+      b.rows_fit.resize(b.idx.size());
+      for (size_t j = 0; j < b.idx.size(); ++j) {
+        b.rows_fit.x[j] = pts[b.idx[j]].x();
+        b.rows_fit.y[j] = pts[b.idx[j]].y();
+        b.rows_fit.z[j] = pts[b.idx[j]].z();
+        b.rows_fit.d2[j] = b.part_d2[j];
+      }
+      return b.rows_fit.d2.back();
     };
     // The wide gathering of g's cell (gathered at its first use) and how far around
     // `at` it surely holds every point, squared.
@@ -417,14 +484,14 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
         else
           h2 = nearestFromWide(at, k, std::numeric_limits<double>::infinity(), b, g);
       }
-      LocalSurface fit = fitPlane(b.row_pts.data(), b.row_d2.data(), b.row_pts.size(), at, h2, b.w);
-      if (fit.centroid_offset > kInsideCentroidOffset && k_edge > b.row_pts.size()) {
+      LocalSurface fit = fitPlane(b.rows_fit, at, h2, b.w);
+      if (fit.centroid_offset > kInsideCentroidOffset && k_edge > b.rows_fit.size()) {
         // Twice the points lie within about √2 the radius that held k (1.6 leaves room
         // for a density falling off towards the edge); further out only if not.
         h2 = nearestFromWide(at, k_edge, 2.56 * h2, b, g);
-        fit = fitPlane(b.row_pts.data(), b.row_d2.data(), b.row_pts.size(), at, h2, b.w);
+        fit = fitPlane(b.rows_fit, at, h2, b.w);
       }
-      if (p.polynomial_order == 2) fitQuadratic(fit, b.row_pts.data(), b.row_pts.size(), b.w);
+      if (p.polynomial_order == 2) fitQuadratic(fit, b.rows_fit, b.w);
       *used_radius = static_cast<float>(std::sqrt(h2));
       return fit;
     };
