@@ -401,7 +401,7 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
   std::vector<double> d;
   for (size_t i = 0; i < e.points.size(); ++i) {
     const double di = at_start ? e.s[i] : e.length - e.s[i];
-    if (di >= skip && di <= skip + reach) {
+    if (di >= skip && di <= std::min(skip + reach, e.length - skip)) {
       pts.push_back(e.points[i]);
       d.push_back(di);
     }
@@ -415,7 +415,9 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
     }
   }
   CornerCurve c;
-  const int used = pts.size() >= 12 ? degree : 1;
+  // At most one coefficient per 8 points, as fitEdge: a quadratic through a dozen
+  // points, extrapolated to the corner, follows a chance dip in the samples.
+  const int used = std::clamp(static_cast<int>(pts.size()) / 8, 1, degree);
   c.curve = fitEdgeCurve(pts, d, used);
   double res2 = 0;
   for (size_t i = 0; i < pts.size(); ++i) res2 += (pts[i] - c.curve.at(d[i])).squaredNorm();
