@@ -384,7 +384,9 @@ void PointGrid::fillTable(NeighbourTable& table, size_t k, const Progress& progr
   table.index.resize(g.pts.size() * k);
   table.dist2.resize(g.pts.size() * k);
   const long cells = static_cast<long>(g.cell_start.size() - 1);
-  const long block = std::max<long>(256, cells / 16);
+  // A few blocks: progress (and a cancelling callback) between them, few barriers
+  // (a thread descheduled on a busy machine stalls the other at each).
+  const long block = std::max<long>(256, cells / 4);
   for (long first = 0; first < cells; first += block) {
     const long last = std::min(cells, first + block);
 #pragma omp parallel
