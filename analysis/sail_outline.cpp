@@ -196,7 +196,7 @@ struct Edge {
 // the edge spoils only its own window) exceeds the mean of such gaps' estimates
 // by (1 − ln 2) of a mean gap; that is taken off.
 struct Frontier {
-  double recess = 0, sigma = 0;       // m
+  double recess = 0;                  // m
   size_t windows = 0;
   std::vector<double> centre, local;  // each window's mid arc position and recess estimate, m
   double median = 0;                  // of `local`, m
@@ -247,16 +247,16 @@ Frontier frontierRecess(std::vector<std::pair<double, double>> along_offset, dou
   std::nth_element(deltas.begin(), deltas.begin() + static_cast<long>(deltas.size() / 2), deltas.end());
   f.median = deltas[deltas.size() / 2];
   f.recess = f.median - (1.0 - std::log(2.0)) * mean_gap;
-  // An exponential gap's spread equals its mean; a median spreads about 1.25x a mean's.
-  f.sigma = 1.25 * mean_gap / std::sqrt(n);
   return f;
 }
 
 // A sampled surface's boundary lies inside the true edge: the outermost samples
 // sit some distance in. Sample offsets from the true edge are uniform on
 // [0, ∞), so within the strip o ≤ D of the found edge (offset o from it,
-// positive inwards) they are uniform on [−δ, D] and δ = D − 2·mean(o).
-// The edge's points are moved out by δ and the curve is fitted again.
+// positive inwards) they are uniform on [−δ, D]. The recess δ comes from the
+// outermost samples of each stretch of the edge (frontierRecess), or, on an edge
+// too short for that, from δ = D − 2·mean(o); the edge's points are moved out by
+// it and the curve is fitted again.
 void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const PointGrid& tree, double spacing) {
   e.length = e.s.back();
   e.exclude = std::max(0.03 * e.length, 6.0 * spacing);
@@ -328,24 +328,20 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
   }
   // δ's σ: offsets spread over about the strip width, uniform.
   double sigma_recess = strip / std::sqrt(3.0);
-  Frontier frontier;
   if (count >= 30) {
     e.recess = std::clamp(strip - 2.0 * sum / static_cast<double>(count), 0.0, strip);
     sigma_recess = 2.0 * strip / std::sqrt(12.0 * static_cast<double>(count));
-    // The mean of the offsets uses every sample in the strip but spreads with the
-    // strip's width: 2 mm on a 10 m luff at 40,000 points, which tilts an upper
-    // section's chord by 0.15°. The outermost sample of each stretch of the edge
-    // lies inside it by a gap that spreads only as much as it is long (about a
-    // millimetre there): estimates from those are several times sharper. They
-    // also hold after smoothing, which pulls a noisy scan's outermost samples in
-    // less than the samples behind them (the mean came out 3-6 mm short there).
-    frontier = frontierRecess(along_offset, strip, 5.0 * spacing);
-    if (frontier.windows >= 6) {
-      e.recess = std::clamp(frontier.recess, 0.0, strip);
-      sigma_recess = frontier.sigma;
-    }
   }
+  // The mean of the offsets uses every sample in the strip but spreads with the
+  // strip's width: 2 mm on a 10 m luff at 40,000 points, which tilts an upper
+  // section's chord by 0.15°. The outermost sample of each stretch of the edge
+  // lies inside it by a gap that spreads only as much as it is long (about a
+  // millimetre there): estimates from those are several times sharper. They
+  // also hold after smoothing, which pulls a noisy scan's outermost samples in
+  // less than the samples behind them (the mean came out 3-6 mm short there).
+  const Frontier frontier = count >= 30 ? frontierRecess(along_offset, strip, 5.0 * spacing) : Frontier{};
   if (frontier.windows >= 6) {
+    e.recess = std::clamp(frontier.recess, 0.0, strip);
     // The recess along the edge: a polynomial of the curve's degree (at most a
     // third as many coefficients as windows) through the windows' estimates, each
     // held within 4 mean gaps of their median (a stray beyond the edge). It takes
