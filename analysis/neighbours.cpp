@@ -646,4 +646,76 @@ void KeyIds::grow() {
   }
 }
 
+double selectNearest(const std::vector<double>& d2, double limit2, size_t k, std::vector<uint8_t>& bin,
+                     std::vector<uint32_t>& part, std::vector<double>& part_d2, std::vector<uint32_t>& out) {
+  if (k == 0) {
+    out.clear();
+    return 0;
+  }
+  constexpr int kBins = 128;  // bin kBins: beyond limit2
+  const double scale = limit2 > 0 && std::isfinite(limit2) ? kBins / limit2 : 0.0;
+  const size_t m = d2.size();
+  bin.resize(m);
+  // Bins first (a loop the compiler vectorises), then counted into four
+  // histograms in turn, so that runs of one bin do not wait on each other.
+  const double* d = d2.data();
+  uint8_t* bn = bin.data();
+  for (size_t j = 0; j < m; ++j) {
+    const double s = std::min(d[j] * scale, static_cast<double>(kBins - 1));
+    bn[j] = static_cast<uint8_t>(static_cast<int>(d[j] <= limit2 ? s : static_cast<double>(kBins)));
+  }
+  uint32_t counts[4][kBins + 1] = {};
+  size_t j = 0;
+  for (; j + 4 <= m; j += 4) {
+    ++counts[0][bn[j]];
+    ++counts[1][bn[j + 1]];
+    ++counts[2][bn[j + 2]];
+    ++counts[3][bn[j + 3]];
+  }
+  for (; j < m; ++j) ++counts[0][bn[j]];
+  uint32_t count[kBins + 1];
+  for (int b = 0; b <= kBins; ++b) count[b] = counts[0][b] + counts[1][b] + counts[2][b] + counts[3][b];
+  size_t below = 0;
+  int last = 0;  // the bin holding the k-th nearest
+  while (last < kBins && below + count[last] < k) below += count[last++];
+  if (last == kBins) return -1;
+  // Slots of the nearer bins are all in; those of bin `last` are selected from.
+  // One pass keeps the slots up to bin `last`, a short one moves those of `last` apart.
+  out.resize(m);
+  size_t o = 0;
+  for (size_t i = 0; i < m; ++i) {
+    out[o] = static_cast<uint32_t>(i);
+    o += bn[i] <= last ? 1 : 0;
+  }
+  part.resize(o);
+  size_t q = 0, kept = 0;
+  for (size_t i = 0; i < o; ++i) {
+    const uint32_t slot = out[i];
+    out[kept] = slot;
+    part[q] = slot;
+    const bool in_last = bn[slot] == last;
+    kept += in_last ? 0 : 1;
+    q += in_last ? 1 : 0;
+  }
+  o = kept;
+  const size_t need = k - below;
+  part_d2.resize(q);
+  for (size_t i = 0; i < q; ++i) part_d2[i] = d2[part[i]];
+  std::nth_element(part_d2.begin(), part_d2.begin() + static_cast<long>(need - 1), part_d2.begin() + static_cast<long>(q));
+  const double t = part_d2[need - 1];
+  size_t ties = 1;  // how many at exactly t belong to the k: the lowest slots
+  for (size_t i = 0; i + 1 < need; ++i) ties += part_d2[i] == t ? 1 : 0;
+  out.resize(o + q);
+  for (size_t i = 0; i < q; ++i) {
+    const double dd = d2[part[i]];
+    const bool tie = dd == t && ties > 0;
+    out[o] = part[i];
+    o += (dd < t || tie) ? 1 : 0;
+    ties -= tie ? 1 : 0;
+  }
+  out.resize(o);
+  return t;
+}
+
+
 }  // namespace sailshape

@@ -115,6 +115,16 @@ Eigen::Vector3i voxelOf(const Vec3& p, double size);
 int64_t voxelKey(const Eigen::Vector3i& cell);
 inline int64_t voxelKey(const Vec3& p, double size) { return voxelKey(voxelOf(p, size)); }
 
+// Of the slots j with d2[j] <= limit2, the k nearest by (distance², slot) into
+// `out`; returns the k-th distance², or -1 when fewer than k lie within limit2.
+// The squared distances are counted in bins of limit2 / kBins (a sample spread
+// evenly over a surface spreads its squared distances evenly too), and only the
+// bin holding the k-th is selected from: one pass over the candidates instead of
+// the several a general selection makes. `out` holds the nearer bins' slots in
+// ascending order, then the rest; `bin`, `part` and `part_d2` are scratch.
+double selectNearest(const std::vector<double>& d2, double limit2, size_t k, std::vector<uint8_t>& bin,
+                     std::vector<uint32_t>& part, std::vector<double>& part_d2, std::vector<uint32_t>& out);
+
 // Dense ids 0, 1, 2, ... for int64 keys (voxel keys) in the order they are first
 // seen: an open-addressing table, several times faster than std::unordered_map
 // for the hundreds of thousands of keys of a cloud.

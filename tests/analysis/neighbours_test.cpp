@@ -434,5 +434,43 @@ TEST(KeyIds, NumbersKeysInTheOrderFirstSeenAndKeepsThemWhileGrowing) {
   EXPECT_EQ(voxels.idOf(voxelKey(Vec3(0.11, 0.02, 0.03), 0.1)), a + 1);
 }
 
+// The binned selection against a plain sort by (distance², slot), on squared
+// distances spread evenly, crowded into a few values (exact ties across the bin
+// holding the k-th) and beyond the limit.
+TEST(SelectNearest, PicksTheKNearestByDistanceThenSlot) {
+  std::mt19937_64 rng(7);
+  std::vector<uint8_t> bin;
+  std::vector<uint32_t> part, out;
+  std::vector<double> part_d2;
+  for (int trial = 0; trial < 300; ++trial) {
+    const size_t m = 1 + rng() % 2000;
+    const bool ties = trial % 3 == 0;
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<double> d2(m);
+    for (double& d : d2) d = ties ? std::floor(u(rng) * 7.0) / 6.0 : 1.2 * u(rng);
+    const double limit2 = trial % 5 == 0 ? 2.0 : u(rng);
+    const size_t k = 1 + rng() % m;
+    std::vector<std::pair<double, uint32_t>> within;
+    for (uint32_t j = 0; j < m; ++j)
+      if (d2[j] <= limit2) within.emplace_back(d2[j], j);
+    std::sort(within.begin(), within.end());
+    const double kth = selectNearest(d2, limit2, k, bin, part, part_d2, out);
+    SCOPED_TRACE("trial " + std::to_string(trial) + ", m " + std::to_string(m) + ", k " + std::to_string(k));
+    if (within.size() < k) {
+      EXPECT_EQ(kth, -1.0);
+      continue;
+    }
+    EXPECT_EQ(kth, within[k - 1].first);
+    std::vector<uint32_t> expected;
+    for (size_t i = 0; i < k; ++i) expected.push_back(within[i].second);
+    std::sort(expected.begin(), expected.end());
+    std::vector<uint32_t> got = out;
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, expected);
+  }
+  EXPECT_EQ(selectNearest({0.5, 0.1}, 1.0, 0, bin, part, part_d2, out), 0.0);
+  EXPECT_TRUE(out.empty());
+}
+
 }  // namespace
 }  // namespace sailshape
