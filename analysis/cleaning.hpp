@@ -46,7 +46,8 @@ Cleaning removeRadiusOutliers(const Cloud& cloud, const NeighbourTable& table, c
 // head, a far and thinly sampled edge) still lie on the surface the kept points
 // describe. A removed point is readmitted when its nearest kept point is within
 // max_gap_factor × the kept points' median spacing and it lies within
-// max_offset_m of the plane through its k nearest kept points; `passes` rounds,
+// max_offset_m (or 3x the neighbours' own RMS about it, where the surface curves
+// within their reach) of the plane through its k nearest kept points; `passes` rounds,
 // so a chain of tip points comes back one by one. Points off the surface
 // (mixed pixels, spray, rigging) stay out.
 struct ReadmitParams {
