@@ -85,8 +85,12 @@ TEST(Worker, CancelStopsTheJobAtItsNextProgressReport) {
     return 0;
   });
   started.wait();
-  cancelled = true;
+  // Cancel first, then raise the test's flag: a step counted after the flag is
+  // one whose progress report came after cancel() took effect (or the single
+  // report already past its check when cancel() was called). The other order
+  // counts the steps the job legitimately runs between the flag and cancel().
   task.cancel();
+  cancelled = true;
   task.wait();
   EXPECT_EQ(task.status().state, JobState::Cancelled);
   EXPECT_LE(steps_after_cancel.load(), 1);
