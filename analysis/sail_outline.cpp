@@ -1,6 +1,7 @@
 #include "analysis/sail_outline.hpp"
 
 #include <algorithm>
+#include <unordered_map>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -27,6 +28,29 @@ std::string fmt(double v, int digits = 3) {
 // one triangle whose reverse b→a no triangle uses. Edges are bucketed by their
 // lower vertex (counting sort, linear in the mesh) instead of hashed: the mesh
 // of a 200,000-point scan has 1.2 million directed edges.
+// The simple loops a closed walk is made of: the walk cut at each vertex it
+// returns to. A vertex may be passed more than once; each pass closes the loop
+// since the last.
+std::vector<std::vector<uint32_t>> simpleLoops(const std::vector<uint32_t>& walk) {
+  std::vector<std::vector<uint32_t>> loops;
+  std::vector<uint32_t> stack;
+  std::unordered_map<uint32_t, size_t> at;  // vertex → its position on the stack
+  for (uint32_t v : walk) {
+    const auto it = at.find(v);
+    if (it != at.end()) {
+      const size_t from = it->second;
+      loops.emplace_back(stack.begin() + static_cast<long>(from), stack.end());
+      for (size_t i = from + 1; i < stack.size(); ++i) at.erase(stack[i]);
+      stack.resize(from + 1);
+      continue;
+    }
+    at[v] = stack.size();
+    stack.push_back(v);
+  }
+  loops.push_back(std::move(stack));
+  return loops;
+}
+
 std::vector<uint32_t> outerBoundaryLoop(const Mesh& mesh) {
   const size_t nv = mesh.vertices.size();
   // Each undirected edge under its lower vertex: the other vertex and whether the
@@ -106,12 +130,20 @@ std::vector<uint32_t> outerBoundaryLoop(const Mesh& mesh) {
         if (!found || loop.size() > boundary.size()) break;
       }
       if (!closed || loop.size() < 3) continue;
-      double len = 0;
-      for (size_t i = 0; i < loop.size(); ++i)
-        len += (mesh.vertices[loop[i]] - mesh.vertices[loop[(i + 1) % loop.size()]]).norm();
-      if (len > best_len) {
-        best_len = len;
-        best = loop;
+      // A hole that touches the outline at one vertex (where two triangles meet
+      // only at their tips) joins the walk there: the walk goes round the hole
+      // and back out. Each simple loop of the walk is a candidate on its own; a
+      // hole's excursion kept in the outline is a deep notch whose turn reads as
+      // a corner (a gennaker's clew was found in mid-luff).
+      for (const std::vector<uint32_t>& simple : simpleLoops(loop)) {
+        if (simple.size() < 3) continue;
+        double len = 0;
+        for (size_t i = 0; i < simple.size(); ++i)
+          len += (mesh.vertices[simple[i]] - mesh.vertices[simple[(i + 1) % simple.size()]]).norm();
+        if (len > best_len) {
+          best_len = len;
+          best = simple;
+        }
       }
     }
   if (best.empty()) throw AnalysisError("[extractOutline] the mesh boundary does not form a closed loop");
@@ -187,6 +219,7 @@ struct Edge {
   EdgeCurve curve;            // fitted on [exclude, length − exclude]
   double recess = 0;          // how far the sampled boundary lies inside the true edge
   double sigma = 0;           // 1σ position uncertainty of the fitted curve
+  double scatter = 0;         // RMS distance of the points from the fitted curve, m
 };
 
 // The recess δ from the outermost samples: the samples' offsets o from the found
@@ -379,6 +412,7 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
   double res2 = 0;
   for (size_t i : inner) res2 += (e.points[i] - e.curve.at(e.s[i])).squaredNorm();
   const double sigma_res = std::sqrt(res2 / static_cast<double>(std::max<size_t>(1, inner.size() - 1)));
+  e.scatter = sigma_res;
   const double sigma_curve = sigma_res * std::sqrt(static_cast<double>(degree + 1) / static_cast<double>(inner.size()));
   e.sigma = std::hypot(sigma_curve, sigma_recess);
 }
@@ -391,37 +425,67 @@ struct CornerCurve {
   double sigma_at_corner = 0;  // m
 };
 
-CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree) {
-  const double skip = 3.0 * spacing, reach = std::max(60.0 * spacing, 0.05 * e.length);
-  std::vector<Vec3> pts;
-  std::vector<double> d;
-  for (size_t i = 0; i < e.points.size(); ++i) {
-    const double di = at_start ? e.s[i] : e.length - e.s[i];
-    if (di >= skip && di <= std::min(skip + reach, e.length - skip)) {
-      pts.push_back(e.points[i]);
-      d.push_back(di);
-    }
-  }
-  if (pts.size() < 6) {  // short edge: all of it
-    pts.clear();
-    d.clear();
+// The curve reaches max(60 boundary spacings, 5 % of the edge) from the corner.
+// With `shorten_if_bent` the reach shrinks (to no less than 30 spacings) while
+// the points scatter about the quadratic more than they scatter about the whole
+// edge's curve and a shorter reach lowers that scatter: the edge bends more
+// than a quadratic follows there. A gennaker's foot leaving the tack and curving
+// away does: over 5 m of its 7 m, the quadratic put the tack 2-3 cm off along the
+// luff. Near a narrow head the scatter rises for another reason (the sail is
+// only a few spacings wide, and its boundary samples zigzag between the sides),
+// where a shorter reach only loses the points that place the sides.
+CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree, bool shorten_if_bent) {
+  const double skip = 3.0 * spacing, longest = std::max(60.0 * spacing, 0.05 * e.length);
+  struct Fit {
+    std::vector<Vec3> pts;
+    std::vector<double> d;
+    int used = 1;
+    EdgeCurve curve;
+    double sigma_res = 0;
+  };
+  auto fitWithin = [&](double reach) {
+    Fit f;
     for (size_t i = 0; i < e.points.size(); ++i) {
-      pts.push_back(e.points[i]);
-      d.push_back(at_start ? e.s[i] : e.length - e.s[i]);
+      const double di = at_start ? e.s[i] : e.length - e.s[i];
+      if (di >= skip && di <= std::min(skip + reach, e.length - skip)) {
+        f.pts.push_back(e.points[i]);
+        f.d.push_back(di);
+      }
+    }
+    if (f.pts.size() < 6) {  // short edge: all of it
+      f.pts.clear();
+      f.d.clear();
+      for (size_t i = 0; i < e.points.size(); ++i) {
+        f.pts.push_back(e.points[i]);
+        f.d.push_back(at_start ? e.s[i] : e.length - e.s[i]);
+      }
+    }
+    // At most one coefficient per 8 points, as fitEdge: a quadratic through a dozen
+    // points, extrapolated to the corner, follows a chance dip in the samples.
+    f.used = std::clamp(static_cast<int>(f.pts.size()) / 8, 1, degree);
+    f.curve = fitEdgeCurve(f.pts, f.d, f.used);
+    double res2 = 0;
+    for (size_t i = 0; i < f.pts.size(); ++i) res2 += (f.pts[i] - f.curve.at(f.d[i])).squaredNorm();
+    f.sigma_res = std::sqrt(res2 / std::max(1.0, static_cast<double>(f.pts.size()) - f.used - 1));
+    return f;
+  };
+  Fit f = fitWithin(longest);
+  if (shorten_if_bent) {
+    for (double reach = longest / 1.25; reach >= 30.0 * spacing; reach /= 1.25) {
+      // The RMS of n residuals spreads by a fraction 1/√(2(n − 3)): twice that is
+      // still the edge's own scatter.
+      const double n = static_cast<double>(f.pts.size());
+      if (f.sigma_res <= e.scatter * (1.0 + 2.0 / std::sqrt(2.0 * std::max(1.0, n - 3.0)))) break;
+      Fit g = fitWithin(reach);
+      if (g.sigma_res >= f.sigma_res) break;
+      f = std::move(g);
     }
   }
   CornerCurve c;
-  // At most one coefficient per 8 points, as fitEdge: a quadratic through a dozen
-  // points, extrapolated to the corner, follows a chance dip in the samples.
-  const int used = std::clamp(static_cast<int>(pts.size()) / 8, 1, degree);
-  c.curve = fitEdgeCurve(pts, d, used);
-  double res2 = 0;
-  for (size_t i = 0; i < pts.size(); ++i) res2 += (pts[i] - c.curve.at(d[i])).squaredNorm();
-  const double n = static_cast<double>(pts.size());
-  const double sigma_res = std::sqrt(res2 / std::max(1.0, n - used - 1));
+  c.curve = f.curve;
   // A least-squares polynomial of degree q over evenly spread points is known at
   // the end of its range to about σ_res·(q + 1)/√N; the corner lies just beyond.
-  c.sigma_at_corner = sigma_res * (used + 1) / std::sqrt(n);
+  c.sigma_at_corner = f.sigma_res * (f.used + 1) / std::sqrt(static_cast<double>(f.pts.size()));
   return c;
 }
 
@@ -438,25 +502,38 @@ struct Meeting {
 };
 
 // The closest pair of points of the two edges' corner curves (quadratics in the
-// distance from the corner, extrapolated back to it).
+// distance from the corner, extrapolated back to it). Corners of 60° and wider
+// (a tack, a clew, a square head) let their curves shorten where an edge bends.
 Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing) {
-  const CornerCurve ca = cornerCurve(a, a_start, spacing, 2), cb = cornerCurve(b, b_start, spacing, 2);
   const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
-  double best = std::numeric_limits<double>::infinity(), sa = 0, sb = 0;
-  double r = range;
-  for (int level = 0; level < 6; ++level) {
-    const double ma = sa, mb = sb;
-    for (int i = -10; i <= 10; ++i)
-      for (int j = -10; j <= 10; ++j) {
-        const double ta = ma + r * i / 10.0, tb = mb + r * j / 10.0;
-        const double dd = (ca.curve.at(ta) - cb.curve.at(tb)).squaredNorm();
-        if (dd < best) {
-          best = dd;
-          sa = ta;
-          sb = tb;
+  auto closest = [&](const CornerCurve& ca, const CornerCurve& cb) {
+    double best = std::numeric_limits<double>::infinity(), sa = 0, sb = 0;
+    double r = range;
+    for (int level = 0; level < 6; ++level) {
+      const double ma = sa, mb = sb;
+      for (int i = -10; i <= 10; ++i)
+        for (int j = -10; j <= 10; ++j) {
+          const double ta = ma + r * i / 10.0, tb = mb + r * j / 10.0;
+          const double dd = (ca.curve.at(ta) - cb.curve.at(tb)).squaredNorm();
+          if (dd < best) {
+            best = dd;
+            sa = ta;
+            sb = tb;
+          }
         }
-      }
-    r /= 5.0;
+      r /= 5.0;
+    }
+    return std::make_pair(sa, sb);
+  };
+  auto angleAt = [](const CornerCurve& ca, double sa, const CornerCurve& cb, double sb) {
+    return std::acos(std::clamp(ca.curve.tangent(sa).dot(cb.curve.tangent(sb)), -1.0, 1.0));
+  };
+  CornerCurve ca = cornerCurve(a, a_start, spacing, 2, false), cb = cornerCurve(b, b_start, spacing, 2, false);
+  auto [sa, sb] = closest(ca, cb);
+  if (angleAt(ca, sa, cb, sb) >= kPi / 3.0) {
+    ca = cornerCurve(a, a_start, spacing, 2, true);
+    cb = cornerCurve(b, b_start, spacing, 2, true);
+    std::tie(sa, sb) = closest(ca, cb);
   }
   Meeting m;
   m.point = 0.5 * (ca.curve.at(sa) + cb.curve.at(sb));

@@ -2,7 +2,9 @@
 // triangulated rectangle (a square-top sail's shape) in the vertical x-z plane.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "analysis/errors.hpp"
@@ -55,6 +57,53 @@ TEST(SailOutline, BoundaryOfARectangleIsItsOuterLoopWithFourCorners) {
   EXPECT_LT((o.peak - Vec3(0, 0, h)).norm(), kSpacing);
   EXPECT_NEAR(o.luff_length_m, h, kSpacing);
   EXPECT_NEAR(o.foot_length_m, w, kSpacing);
+}
+
+// A hole that touches an edge at one vertex, where two triangles meet only at
+// their tips: the hole's loop and the outer loop pass through that vertex. The
+// outline goes straight on along the edge there; taken round the hole, the
+// hole's far side reads as a sharp corner (a gennaker's clew was once found in
+// mid-luff that way). Once on the leech (x = 0), once on the luff (x = width):
+// a walk may leave the pinch either way.
+TEST(SailOutline, AHoleTouchingAnEdgeAtOneVertexStaysOutOfTheOutline) {
+  auto v = [](int i, int j) { return static_cast<uint32_t>(j * (kCellsX + 1) + i); };
+  constexpr int j0 = 40;  // the pinch's row, mid-height
+  for (const bool on_luff : {false, true}) {
+    SCOPED_TRACE(on_luff ? "pinch on the luff" : "pinch on the leech");
+    const int pinch_i = on_luff ? kCellsX : 0;
+    // The one triangle at the pinch that holds neither of its edge segments, and
+    // a block of 10 x 10 cells beside it.
+    const std::array<uint32_t, 3> tip_triangle =
+        on_luff ? std::array<uint32_t, 3>{v(kCellsX - 1, j0 - 1), v(kCellsX, j0), v(kCellsX - 1, j0)}
+                : std::array<uint32_t, 3>{v(0, j0), v(1, j0), v(1, j0 + 1)};
+    const int hole_i = on_luff ? kCellsX - 11 : 1, hole_j = on_luff ? j0 - 5 : j0;
+    Mesh m = rectangle();
+    std::vector<std::array<uint32_t, 3>> kept;
+    for (const auto& t : m.triangles) {
+      // Both triangles of cell (i, j) start at its vertex (i, j).
+      const int i = static_cast<int>(t[0] % (kCellsX + 1)), j = static_cast<int>(t[0] / (kCellsX + 1));
+      const bool in_hole = i >= hole_i && i < hole_i + 10 && j >= hole_j && j < hole_j + 10;
+      if (!in_hole && t != tip_triangle) kept.push_back(t);
+    }
+    m.triangles = kept;
+    // The fixture is what it claims: four boundary edges meet at the pinch.
+    std::map<std::pair<uint32_t, uint32_t>, int> uses;
+    for (const auto& t : m.triangles)
+      for (int e = 0; e < 3; ++e) ++uses[std::minmax(t[e], t[(e + 1) % 3])];
+    int at_pinch = 0;
+    for (const auto& [edge, n] : uses) at_pinch += n == 1 && (edge.first == v(pinch_i, j0) || edge.second == v(pinch_i, j0));
+    ASSERT_EQ(at_pinch, 4);
+
+    const SailOutline o = extractOutline(m);
+    ASSERT_EQ(o.boundary.size(), static_cast<size_t>(2 * (kCellsX + kCellsZ)));
+    for (const Vec3& p : o.boundary) EXPECT_TRUE(onRectangleEdge(p)) << p.transpose();
+    ASSERT_TRUE(o.has_peak);
+    const double w = kCellsX * kSpacing, h = kCellsZ * kSpacing;
+    EXPECT_LT((o.tack - Vec3(w, 0, 0)).norm(), kSpacing);
+    EXPECT_LT((o.clew - Vec3(0, 0, 0)).norm(), kSpacing);
+    EXPECT_LT((o.head - Vec3(w, 0, h)).norm(), kSpacing);
+    EXPECT_LT((o.peak - Vec3(0, 0, h)).norm(), kSpacing);
+  }
 }
 
 TEST(SailOutline, ATriangleNamingAMissingVertexIsRejected) {
