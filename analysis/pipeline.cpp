@@ -213,6 +213,17 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), c.warnings);
   }
   a.sail_points = cloud.size();
+  // The samples the filters removed and readmission left out, for the corners
+  // only: a lone sample near a narrow tip stands apart from the rest and off the
+  // plane of its neighbours 10-25 cm back, yet the corner's own surface, fitted
+  // over far more of the sail, can still take it (extractOutline tests each).
+  std::vector<Vec3> removed;
+  {
+    std::vector<char> in(segmented.size(), 0);
+    for (uint32_t i : kept) in[i] = 1;
+    for (uint32_t i = 0; i < segmented.size(); ++i)
+      if (!in[i]) removed.push_back(segmented.points[i]);
+  }
 
   if (p.smooth) {
     StageTimer t(a, "smoothing", cloud.size());
@@ -224,7 +235,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), s.warnings);
   }
 
-  std::vector<Vec3> loose;  // smoothed sail points the mesh left out
+  std::vector<Vec3> loose = std::move(removed);  // and the smoothed sail points the mesh left out
   {
     StageTimer t(a, "surface", cloud.size());
     Surface s = reconstructSurface(cloud, p.surface, progress);
