@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,27 @@ inline void expectFileError(const std::function<void()>& f, const std::string& p
         }
       },
       FileError);
+}
+
+// The cloud without the points within `radius` of `corner`, and the nearest of
+// those apart: a corner whose last sample stands alone.
+struct LoneTip {
+  Cloud rest;
+  Vec3 tip = Vec3::Zero();
+  double tip_distance_m = std::numeric_limits<double>::infinity();
+};
+inline LoneTip isolateTip(const Cloud& cloud, const Vec3& corner, double radius) {
+  LoneTip out;
+  for (const Vec3& p : cloud.points) {
+    const double d = (p - corner).norm();
+    if (d >= radius)
+      out.rest.points.push_back(p);
+    else if (d < out.tip_distance_m) {
+      out.tip_distance_m = d;
+      out.tip = p;
+    }
+  }
+  return out;
 }
 
 // Point i of n nearly uniform on the unit sphere (Fibonacci lattice): no clumps,

@@ -38,6 +38,15 @@ struct Tolerance {
 // entry/exit 1°), corners 3 cm.
 constexpr Tolerance kClean{0.1, 1.0, 0.1, 1.0, 0.03};
 
+// A scan of `points` samples on the sail, with range noise σ = noise_m.
+ScanSimulation scan(size_t points, uint64_t seed = 1, double noise_m = 0.0) {
+  ScanSimulation sim;
+  sim.points = points;
+  sim.seed = seed;
+  sim.noise_sigma_m = noise_m;
+  return sim;
+}
+
 void expectSectionsMatch(const SailAnalysis& a, const SailSurface& truth, const Tolerance& tol) {
   ASSERT_EQ(a.sections.sections.size(), 3u);
   for (const Section& s : a.sections.sections) {
@@ -61,8 +70,7 @@ void expectSectionsMatch(const SailAnalysis& a, const SailSurface& truth, const 
 
 TEST(Pipeline, CleanMainsailRecoversKnownSectionsAndCorners) {
   const SailDesign design = exampleDesign(SailType::Main);
-  ScanSimulation sim;
-  sim.points = 40000;
+  const ScanSimulation sim = scan(40000);
   const Cloud cloud = sampleSail(design, sim);
   const SailAnalysis a = analyzeSail(cloud);
   const SailSurface truth(design);
@@ -75,8 +83,7 @@ TEST(Pipeline, CleanMainsailRecoversKnownSectionsAndCorners) {
 
 TEST(Pipeline, CleanSquareTopMainsailFindsFourCornersAndKnownSections) {
   const SailDesign design = exampleDesign(SailType::SquareTopMain);
-  ScanSimulation sim;
-  sim.points = 40000;
+  const ScanSimulation sim = scan(40000);
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   const SailSurface truth(design);
   ASSERT_TRUE(a.outline.has_peak);
@@ -94,10 +101,7 @@ TEST(Pipeline, SquareTopPeakStaysWithinTheTargetWhereItsShortTopEdgeIsThinlySamp
   const SailSurface truth(design);
   for (const auto& [noise, seed] : {std::pair{0.0, 3}, {kSigma, 6}}) {
     SCOPED_TRACE("noise " + std::to_string(noise) + " seed " + std::to_string(seed));
-    ScanSimulation sim;
-    sim.points = 40000;
-    sim.noise_sigma_m = noise;
-    sim.seed = static_cast<uint64_t>(seed);
+    const ScanSimulation sim = scan(40000, static_cast<uint64_t>(seed), noise);
     const SailAnalysis a = analyzeSail(sampleSail(design, sim));
     ASSERT_TRUE(a.outline.has_peak);
     EXPECT_LT((a.outline.peak - truth.peak()).norm(), kClean.corner_m);
@@ -114,9 +118,7 @@ TEST(Pipeline, SquareTopPeakStaysWithinTheTargetWhereItsShortTopEdgeIsThinlySamp
 // head came out 4.6 cm low.
 TEST(Pipeline, CleanGennakerKeepsItsTipSamplesAndItsHead) {
   const SailDesign design = exampleDesign(SailType::Gennaker);
-  ScanSimulation sim;
-  sim.points = 40000;
-  sim.seed = 10;
+  const ScanSimulation sim = scan(40000, 10);
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   EXPECT_EQ(a.sail_points, sim.points);
   EXPECT_LT((a.outline.head - SailSurface(design).head()).norm(), kClean.corner_m);
@@ -130,9 +132,7 @@ TEST(Pipeline, CleanGennakerKeepsItsTipSamplesAndItsHead) {
 TEST(Pipeline, GennakerTackHoldsWhereItsFootCurvesAway) {
   const SailDesign design = exampleDesign(SailType::Gennaker);
   for (const uint64_t seed : {4, 5, 9}) {
-    ScanSimulation sim;
-    sim.points = 40000;
-    sim.seed = seed;
+    const ScanSimulation sim = scan(40000, seed);
     const SailAnalysis a = analyzeSail(sampleSail(design, sim));
     EXPECT_LT((a.outline.tack - SailSurface(design).tack()).norm(), 0.017) << "seed " << seed;
   }
@@ -142,9 +142,7 @@ TEST(Pipeline, GennakerTackHoldsWhereItsFootCurvesAway) {
 // outline walked round it and named its far side the clew, 6.5 m from the real one.
 TEST(Pipeline, GennakerOutlineStaysOutOfAHoleThatTouchesItsLuff) {
   const SailDesign design = exampleDesign(SailType::Gennaker);
-  ScanSimulation sim;
-  sim.points = 40000;
-  sim.seed = 20;
+  const ScanSimulation sim = scan(40000, 20);
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   const SailSurface truth(design);
   EXPECT_LT((a.outline.clew - truth.clew()).norm(), kClean.corner_m);
@@ -161,24 +159,12 @@ TEST(Pipeline, GennakerOutlineStaysOutOfAHoleThatTouchesItsLuff) {
 TEST(Pipeline, AHeadReachesItsLoneTipSampleThatCleaningRemoved) {
   const SailDesign design = exampleDesign(SailType::Gennaker);
   const SailSurface truth(design);
-  ScanSimulation sim;
-  sim.points = 40000;
-  sim.seed = 3;
-  const Cloud sampled = sampleSail(design, sim);
+  const ScanSimulation sim = scan(40000, 3);
   const Vec3 head = truth.head();
-  Cloud kept;
-  Vec3 tip = Vec3::Zero();
-  double tip_d = 1e9;
-  for (const Vec3& p : sampled.points) {
-    const double d = (p - head).norm();
-    if (d >= 0.20)
-      kept.points.push_back(p);
-    else if (d < tip_d) {
-      tip_d = d;
-      tip = p;
-    }
-  }
-  ASSERT_LT(tip_d, 0.06) << "the sampling left no sample near the head";
+  LoneTip cut = isolateTip(sampleSail(design, sim), head, 0.20);
+  ASSERT_LT(cut.tip_distance_m, 0.06) << "the sampling left no sample near the head";
+  const Vec3 tip = cut.tip;
+  Cloud kept = std::move(cut.rest);
   kept.points.push_back(tip);
   const SailAnalysis a = analyzeSail(kept);
   ASSERT_EQ(a.sail_points + 1, kept.size()) << "the lone tip sample was meant to be left out by cleaning";
@@ -190,8 +176,7 @@ TEST(Pipeline, AHeadReachesItsLoneTipSampleThatCleaningRemoved) {
 
 TEST(Pipeline, CleanJibRecoversKnownSections) {
   const SailDesign design = exampleDesign(SailType::Jib);
-  ScanSimulation sim;
-  sim.points = 40000;
+  const ScanSimulation sim = scan(40000);
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   expectSectionsMatch(a, SailSurface(design), kClean);
   EXPECT_FALSE(a.outline.has_peak);
@@ -206,9 +191,7 @@ TEST(Pipeline, CleanMainAndJibTwistsStayWithinATenthOfADegreeOverSeeds) {
   for (const auto& [type, seed] : {std::pair{SailType::Main, 4}, {SailType::Jib, 3}, {SailType::Jib, 4}}) {
     SCOPED_TRACE("type " + std::to_string(static_cast<int>(type)) + " seed " + std::to_string(seed));
     const SailDesign design = exampleDesign(type);
-    ScanSimulation sim;
-    sim.points = 40000;
-    sim.seed = static_cast<uint64_t>(seed);
+    const ScanSimulation sim = scan(40000, static_cast<uint64_t>(seed));
     const SailAnalysis a = analyzeSail(sampleSail(design, sim));
     const SailSurface truth(design);
     for (const Section& s : a.sections.sections)
@@ -223,8 +206,7 @@ TEST(Pipeline, CleanGennakerRecoversKnownSectionsAndLuffCurve) {
   // analysis reports that uncertainty, and the error lands either side of 0.1°
   // from seed to seed); four times the points resolve the target.
   const SailDesign design = exampleDesign(SailType::Gennaker);
-  ScanSimulation sim;
-  sim.points = 400000;
+  const ScanSimulation sim = scan(400000);
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   const SailSurface truth(design);
   expectSectionsMatch(a, truth, kClean);
@@ -251,9 +233,7 @@ TEST(Pipeline, NoisyMainsailRecoversKnownSectionsWithinTheNoiseTargets) {
   // 4 mm range noise (SPEC §3) on a 10 m mainsail: the noisy targets,
   // camber 0.3 % of chord, draft 2 %, twist 0.3°, entry/exit 2.5°; corners 3 cm.
   const SailDesign design = exampleDesign(SailType::Main);
-  ScanSimulation sim;
-  sim.points = 40000;
-  sim.noise_sigma_m = 0.004;
+  const ScanSimulation sim = scan(40000, 1, 0.004);
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   const SailSurface truth(design);
   ASSERT_EQ(a.sections.sections.size(), 3u);
@@ -277,10 +257,7 @@ TEST(Pipeline, NoisyJibMeetsTheTargetsWithItsTackOnTheSurface) {
   // A jib's foot leaves the tack at the entry angle and curves away in depth;
   // the edges' crossing alone put the tack 3-4 cm off the sail's surface.
   const SailDesign design = exampleDesign(SailType::Jib);
-  ScanSimulation sim;
-  sim.points = 40000;
-  sim.noise_sigma_m = 0.004;
-  sim.seed = 2;
+  const ScanSimulation sim = scan(40000, 2, 0.004);
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   expectNoisyTargets(a, design);
 }
@@ -291,19 +268,14 @@ TEST(Pipeline, DenseNoisyMainsailKeepsItsEndAnglesWithinTheNoiseTargets) {
   // point's one-sided quadratic tilts with the noise; on this seed the top
   // section's exit came out 3.8° off when edge fits used k points, not 2k.
   const SailDesign design = exampleDesign(SailType::Main);
-  ScanSimulation sim;
-  sim.points = 200000;
-  sim.noise_sigma_m = 0.004;
-  sim.seed = 3;
+  const ScanSimulation sim = scan(200000, 3, 0.004);
   const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   expectNoisyTargets(a, design);
 }
 
 TEST(Pipeline, SceneWithMastBoomAndDeckIsSegmentedToTheSail) {
   const SailDesign design = exampleDesign(SailType::Main);
-  ScanSimulation sim;
-  sim.points = 40000;
-  sim.noise_sigma_m = 0.004;
+  const ScanSimulation sim = scan(40000, 1, 0.004);
   const SceneCloud scene = sampleSailScene(design, sim);
   const SailAnalysis a = analyzeSail(scene.cloud);
   // The picked cluster (before cleaning) holds >= 98 % of the sail's points

@@ -40,6 +40,17 @@ bool onRectangleEdge(const Vec3& p) {
   return std::abs(p.x()) < eps || std::abs(p.x() - w) < eps || std::abs(p.z()) < eps || std::abs(p.z() - h) < eps;
 }
 
+// Square top: tack forward (larger x) at the foot, head forward at the top. The
+// corners are sampled exactly; the fitted edges may move them by up to a spacing.
+void expectRectangleCorners(const SailOutline& o) {
+  ASSERT_TRUE(o.has_peak);
+  const double w = kCellsX * kSpacing, h = kCellsZ * kSpacing;
+  EXPECT_LT((o.tack - Vec3(w, 0, 0)).norm(), kSpacing);
+  EXPECT_LT((o.clew - Vec3(0, 0, 0)).norm(), kSpacing);
+  EXPECT_LT((o.head - Vec3(w, 0, h)).norm(), kSpacing);
+  EXPECT_LT((o.peak - Vec3(0, 0, h)).norm(), kSpacing);
+}
+
 TEST(SailOutline, BoundaryOfARectangleIsItsOuterLoopWithFourCorners) {
   // A hole of 10 x 10 cells: a second boundary loop, shorter than the outer one.
   const SailOutline o = extractOutline(rectangle(15, 24));
@@ -47,14 +58,8 @@ TEST(SailOutline, BoundaryOfARectangleIsItsOuterLoopWithFourCorners) {
   ASSERT_EQ(o.boundary.size(), static_cast<size_t>(2 * (kCellsX + kCellsZ)));
   for (const Vec3& p : o.boundary) EXPECT_TRUE(onRectangleEdge(p)) << p.transpose();
   EXPECT_NEAR(o.boundary_spacing_m, kSpacing, 1e-12);
-  // Square top: tack forward (larger x) at the foot, head forward at the top.
-  ASSERT_TRUE(o.has_peak);
+  expectRectangleCorners(o);
   const double w = kCellsX * kSpacing, h = kCellsZ * kSpacing;
-  // The corners are sampled exactly; the fitted edges may move them by up to a spacing.
-  EXPECT_LT((o.tack - Vec3(w, 0, 0)).norm(), kSpacing);
-  EXPECT_LT((o.clew - Vec3(0, 0, 0)).norm(), kSpacing);
-  EXPECT_LT((o.head - Vec3(w, 0, h)).norm(), kSpacing);
-  EXPECT_LT((o.peak - Vec3(0, 0, h)).norm(), kSpacing);
   EXPECT_NEAR(o.luff_length_m, h, kSpacing);
   EXPECT_NEAR(o.foot_length_m, w, kSpacing);
 }
@@ -97,12 +102,7 @@ TEST(SailOutline, AHoleTouchingAnEdgeAtOneVertexStaysOutOfTheOutline) {
     const SailOutline o = extractOutline(m);
     ASSERT_EQ(o.boundary.size(), static_cast<size_t>(2 * (kCellsX + kCellsZ)));
     for (const Vec3& p : o.boundary) EXPECT_TRUE(onRectangleEdge(p)) << p.transpose();
-    ASSERT_TRUE(o.has_peak);
-    const double w = kCellsX * kSpacing, h = kCellsZ * kSpacing;
-    EXPECT_LT((o.tack - Vec3(w, 0, 0)).norm(), kSpacing);
-    EXPECT_LT((o.clew - Vec3(0, 0, 0)).norm(), kSpacing);
-    EXPECT_LT((o.head - Vec3(w, 0, h)).norm(), kSpacing);
-    EXPECT_LT((o.peak - Vec3(0, 0, h)).norm(), kSpacing);
+    expectRectangleCorners(o);
   }
 }
 
@@ -160,21 +160,11 @@ TEST(SailOutline, AHeadReachesTheLooseSampleTheMeshLeftOut) {
   ScanSimulation sim;
   sim.points = 40'000;
   sim.seed = 5;
-  const Cloud sampled = sampleSail(design, sim);
   const Vec3 head = truth.head();
-  Cloud kept;
-  Vec3 tip = Vec3::Zero();
-  double tip_d = 1e9;
-  for (const Vec3& p : sampled.points) {
-    const double d = (p - head).norm();
-    if (d >= 0.12)
-      kept.points.push_back(p);
-    else if (d < tip_d) {
-      tip_d = d;
-      tip = p;
-    }
-  }
-  ASSERT_LT(tip_d, 0.05) << "the sampling left no sample near the head";
+  const LoneTip cut = isolateTip(sampleSail(design, sim), head, 0.12);
+  ASSERT_LT(cut.tip_distance_m, 0.05) << "the sampling left no sample near the head";
+  const Vec3& tip = cut.tip;
+  const Cloud& kept = cut.rest;
   const Mesh mesh = reconstructSurface(kept).mesh;
 
   const SailOutline without = extractOutline(mesh);
