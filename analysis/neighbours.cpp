@@ -628,6 +628,55 @@ uint32_t KeyIds::idOf(int64_t key) {
   }
 }
 
+bool KeyIds::find(int64_t key, uint32_t& id) const {
+  const size_t mask = key_.size() - 1;
+  for (size_t s = (static_cast<uint64_t>(key) * 0x9E3779B97F4A7C15ull) >> shift_;; s = (s + 1) & mask) {
+    if (id_[s] == kFree) return false;
+    if (key_[s] == key) {
+      id = id_[s];
+      return true;
+    }
+  }
+}
+
+bool medianNeighbourDistanceBelow(const std::vector<Vec3>& points, double limit_m, size_t samples) {
+  const size_t n = points.size();
+  if (n < 2) return 0.0 < limit_m;  // medianNeighbourDistance gives 0
+  if (!(limit_m > 0)) return false;
+  // A point nearer than limit_m lies in one of the 27 cells around the sample's; the
+  // cells are a hair wider so that rounding in the cell index cannot push it further.
+  const double cell = limit_m * (1 + 1e-9);
+  KeyIds ids(n / 4);
+  std::vector<uint32_t> cell_of(n);
+  for (size_t i = 0; i < n; ++i) cell_of[i] = ids.idOf(voxelKey(points[i], cell));
+  std::vector<uint32_t> start(ids.size() + 1, 0), members(n);
+  for (uint32_t c : cell_of) ++start[c + 1];
+  for (size_t c = 0; c < ids.size(); ++c) start[c + 1] += start[c];
+  {
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (uint32_t i = 0; i < n; ++i) members[fill[cell_of[i]]++] = i;
+  }
+  // The same samples as medianNeighbourDistance; the median is the (m/2)-th smallest
+  // of their m distances, below the limit when more than m/2 of them are.
+  const size_t step = std::max<size_t>(1, n / std::max<size_t>(1, samples));
+  size_t m = 0, below = 0;
+  for (size_t i = 0; i < n; i += step) {
+    ++m;
+    const Eigen::Vector3i c = voxelOf(points[i], cell);
+    double best2 = std::numeric_limits<double>::infinity();
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          uint32_t id = 0;
+          if (!ids.find(voxelKey(Eigen::Vector3i(c.x() + dx, c.y() + dy, c.z() + dz)), id)) continue;
+          for (uint32_t s = start[id]; s < start[id + 1]; ++s)
+            if (members[s] != i) best2 = std::min(best2, (points[members[s]] - points[i]).squaredNorm());
+        }
+    below += std::sqrt(best2) < limit_m ? 1 : 0;
+  }
+  return below >= m / 2 + 1;
+}
+
 void KeyIds::grow() {
   std::vector<int64_t> old_key;
   std::vector<uint32_t> old_id;

@@ -142,8 +142,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     // Work on a voxel-grid sample when the scan is denser than the voxel.
     const double voxel = p.segmentation_voxel_sigmas * p.sensor_sigma_m;
     VoxelSample sample;
-    // The median spacing from a grid of voxel-wide cells (one build; any cell width gives the same median).
-    const bool thin = voxel > 0 && medianNeighbourDistance(PointGrid(cloud.points, voxel), cloud.points, 2) < 0.8 * voxel;
+    const bool thin = voxel > 0 && medianNeighbourDistanceBelow(cloud.points, 0.8 * voxel);
     if (thin) sample = voxelSample(cloud, voxel);
     const Cloud& seg_cloud = thin ? sample.cloud : cloud;
     const size_t k = static_cast<size_t>(std::max(p.normals.k_neighbours, p.region_growing.k_neighbours));

@@ -415,6 +415,43 @@ TEST(MedianSpacing, IsZeroWithoutASecondColumnOrPoint) {
   EXPECT_EQ(medianSpacing(NeighbourTable{}), 0.0);
 }
 
+// The yes-or-no against the median itself: false at the median (not below it),
+// true just above; on a noisy sheet of random points (a scan's spacing spread), one
+// with exact duplicates (distance 0) and a regular grid (every distance tied).
+TEST(MedianNeighbourDistanceBelow, AgreesWithTheMedianAtAndAroundIt) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(0.0, 1.5);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  std::vector<Vec3> sheet(20000);
+  for (Vec3& p : sheet) p = Vec3(U(rng), U(rng), noise(rng));
+  std::vector<Vec3> doubled(sheet.begin(), sheet.begin() + 3000);
+  for (size_t i = 0; i < 600; ++i) doubled.push_back(doubled[i * 5]);  // a third of the points: 0 apart
+  for (const std::vector<Vec3>* pts : {&sheet, &doubled}) {
+    for (size_t samples : {size_t{512}, size_t{97}}) {
+      const double median = medianNeighbourDistance(PointGrid(*pts, 0.05), *pts, 2, samples);
+      ASSERT_GT(median, 0.0);
+      EXPECT_FALSE(medianNeighbourDistanceBelow(*pts, median, samples));
+      EXPECT_TRUE(medianNeighbourDistanceBelow(*pts, std::nextafter(median, 1.0), samples));
+      for (double f : {0.3, 0.9, 1.1, 3.0})
+        EXPECT_EQ(medianNeighbourDistanceBelow(*pts, f * median, samples), f > 1) << f << " " << samples;
+    }
+  }
+  // More than half the sample duplicated: the median is 0, below any positive limit.
+  std::vector<Vec3> twice = grid(20, 0.1);
+  twice.insert(twice.end(), twice.begin(), twice.end());
+  EXPECT_TRUE(medianNeighbourDistanceBelow(twice, 1e-9));
+  // Every nearest distance is the spacing h on a grid (to rounding: many near-ties).
+  const std::vector<Vec3> g = grid(30, 0.02);
+  const double h = medianNeighbourDistance(PointGrid(g, 0.05), g, 2);
+  EXPECT_NEAR(h, 0.02, 1e-12);
+  EXPECT_FALSE(medianNeighbourDistanceBelow(g, h));
+  EXPECT_TRUE(medianNeighbourDistanceBelow(g, std::nextafter(h, 1.0)));
+  // Fewer than two points: the median distance is 0.
+  EXPECT_TRUE(medianNeighbourDistanceBelow({Vec3(1, 2, 3)}, 0.01));
+  EXPECT_FALSE(medianNeighbourDistanceBelow(g, 0.0));
+  EXPECT_FALSE(medianNeighbourDistanceBelow(g, -1.0));
+}
+
 TEST(KeyIds, NumbersKeysInTheOrderFirstSeenAndKeepsThemWhileGrowing) {
   // Starts small (16 slots) and grows many times over 10,000 keys, negative and
   // colliding-prone (multiples of a large power of two) among them.
@@ -426,6 +463,16 @@ TEST(KeyIds, NumbersKeysInTheOrderFirstSeenAndKeepsThemWhileGrowing) {
     EXPECT_EQ(ids.size(), i + 1);
   }
   for (size_t i = 0; i < keys.size(); i += 7) EXPECT_EQ(ids.idOf(keys[i]), i);
+  EXPECT_EQ(ids.size(), keys.size());
+  // find gives the same ids and adds nothing.
+  for (size_t i = 0; i < keys.size(); i += 13) {
+    uint32_t id = 0;
+    ASSERT_TRUE(ids.find(keys[i], id));
+    EXPECT_EQ(id, i);
+  }
+  uint32_t none = 7;
+  EXPECT_FALSE(ids.find(int64_t{1} << 62, none));
+  EXPECT_EQ(none, 7u);
   EXPECT_EQ(ids.size(), keys.size());
   // The voxel keys of points in the same cube share an id.
   KeyIds voxels;
