@@ -136,20 +136,7 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
   dt.insert(projected.begin(), projected.end());
   progress("surface", 0.5);
 
-  // The vertices renumbered in the triangulation's storage order (spatially sorted):
-  // the face loop below then reads their 3D points from nearby memory, not from all
-  // over the cloud (whose order may be random). src: the input index of each.
-  std::vector<uint32_t> src;
-  src.reserve(projected.size());
-  std::vector<Vec3> p3;
-  p3.reserve(projected.size());
-  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v) {
-    src.push_back(v->info());
-    p3.push_back(cloud.points[v->info()]);
-    v->info() = static_cast<uint32_t>(src.size() - 1);
-  }
-
-  std::vector<std::array<uint32_t, 3>> tris;  // vertices by their numbers above
+  std::vector<std::array<uint32_t, 3>> tris;
   tris.reserve(static_cast<size_t>(dt.number_of_faces()));
   std::vector<double> edge_len;
   edge_len.reserve(static_cast<size_t>(dt.number_of_faces()) * 3);
@@ -167,7 +154,7 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
     std::array<uint32_t, 3> t{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
     f->info() = static_cast<uint32_t>(tris.size());
     tris.push_back(t);
-    for (int e = 0; e < 3; ++e) edge_len.push_back((p3[t[e]] - p3[t[(e + 1) % 3]]).norm());
+    for (int e = 0; e < 3; ++e) edge_len.push_back((cloud.points[t[e]] - cloud.points[t[(e + 1) % 3]]).norm());
   }
   result.delaunay_triangles = tris.size();
   if (tris.empty()) throw AnalysisError("[reconstructSurface] the points are collinear in the projection: no triangle");
@@ -190,8 +177,6 @@ Surface reconstructSurface(const Cloud& cloud, const SurfaceParams& p, const Pro
     throw AnalysisError("[reconstructSurface] every triangle has an edge longer than max_edge_m = " +
                         std::to_string(max_edge) + " m");
   if (p.largest_component_only) result.dropped_small_components = keepLargestComponent(dt, slot, kept);
-  for (auto& t : kept)
-    for (uint32_t& v : t) v = src[v];
 
   // Compact: mesh vertices are the used input points, in input order.
   std::vector<uint32_t> remap(cloud.size(), std::numeric_limits<uint32_t>::max());
