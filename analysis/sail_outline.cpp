@@ -173,19 +173,41 @@ std::vector<Vec3> vertexNormals(const Mesh& mesh) {
   return n;
 }
 
-// A smooth edge: P(s) = Σ_k c_k u^k with u = (s − mid) / half, s in metres of
-// boundary arc from the edge's first corner. Fitted by least squares.
-struct EdgeCurve {
-  Eigen::MatrixXd coeffs;  // (degree + 1) × 3
+// Least-squares polynomials of one variable s, one per column of values:
+// Σ_k c_k u^k with u = (s − mid) / half, the samples' range mapped onto [−1, 1].
+struct Polynomial {
+  Eigen::MatrixXd coeffs;  // (degree + 1) × columns
   double mid = 0, half = 1;
 
-  Vec3 at(double s) const {
+  Eigen::RowVectorXd at(double s) const {
     const double u = (s - mid) / half;
-    Vec3 p = Vec3::Zero();
+    Eigen::RowVectorXd v = Eigen::RowVectorXd::Zero(coeffs.cols());
     double uk = 1;
-    for (Eigen::Index k = 0; k < coeffs.rows(); ++k, uk *= u) p += uk * coeffs.row(k).transpose();
-    return p;
+    for (Eigen::Index k = 0; k < coeffs.rows(); ++k, uk *= u) v += uk * coeffs.row(k);
+    return v;
   }
+};
+
+// `values` has one row per entry of s.
+Polynomial fitPolynomial(const std::vector<double>& s, const Eigen::MatrixXd& values, int degree) {
+  Polynomial p;
+  const double lo = *std::min_element(s.begin(), s.end()), hi = *std::max_element(s.begin(), s.end());
+  p.mid = 0.5 * (lo + hi);
+  p.half = std::max(1e-9, 0.5 * (hi - lo));
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(s.size()), degree + 1);
+  for (size_t i = 0; i < s.size(); ++i) {
+    const double u = (s[i] - p.mid) / p.half;
+    double uk = 1;
+    for (int k = 0; k <= degree; ++k, uk *= u) A(static_cast<Eigen::Index>(i), k) = uk;
+  }
+  p.coeffs = A.colPivHouseholderQr().solve(values);
+  return p;
+}
+
+// A smooth edge: a point for each s, in metres of boundary arc from the edge's
+// first corner.
+struct EdgeCurve : Polynomial {
+  Vec3 at(double s) const { return Polynomial::at(s).transpose(); }
   Vec3 tangent(double s) const {
     const double h = 1e-4 * half;
     return (at(s + h) - at(s - h)).normalized();
@@ -193,20 +215,9 @@ struct EdgeCurve {
 };
 
 EdgeCurve fitEdgeCurve(const std::vector<Vec3>& pts, const std::vector<double>& s, int degree) {
-  EdgeCurve c;
-  const double lo = *std::min_element(s.begin(), s.end()), hi = *std::max_element(s.begin(), s.end());
-  c.mid = 0.5 * (lo + hi);
-  c.half = std::max(1e-9, 0.5 * (hi - lo));
-  Eigen::MatrixXd A(static_cast<Eigen::Index>(pts.size()), degree + 1);
-  Eigen::MatrixXd B(static_cast<Eigen::Index>(pts.size()), 3);
-  for (size_t i = 0; i < pts.size(); ++i) {
-    const double u = (s[i] - c.mid) / c.half;
-    double uk = 1;
-    for (int k = 0; k <= degree; ++k, uk *= u) A(static_cast<Eigen::Index>(i), k) = uk;
-    B.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
-  }
-  c.coeffs = A.colPivHouseholderQr().solve(B);
-  return c;
+  Eigen::MatrixXd xyz(static_cast<Eigen::Index>(pts.size()), 3);
+  for (size_t i = 0; i < pts.size(); ++i) xyz.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
+  return EdgeCurve{fitPolynomial(s, xyz, degree)};
 }
 
 // One sail edge as found on the boundary: its points from corner to corner
@@ -382,23 +393,14 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
     // samples scattered by one gap each leaves at 3-5 mm on a gennaker's luff.
     const size_t m = frontier.local.size();
     const int deg = std::min(degree, static_cast<int>(m / 3) - 1);
-    const double lo = frontier.centre.front(), hi = frontier.centre.back();
-    const double mid = 0.5 * (lo + hi), half = std::max(1e-9, 0.5 * (hi - lo));
-    Eigen::MatrixXd A(static_cast<Eigen::Index>(m), deg + 1);
-    Eigen::VectorXd y(static_cast<Eigen::Index>(m));
-    for (size_t j = 0; j < m; ++j) {
-      const double u = (frontier.centre[j] - mid) / half;
-      double uk = 1;
-      for (int k = 0; k <= deg; ++k, uk *= u) A(static_cast<Eigen::Index>(j), k) = uk;
-      y[static_cast<Eigen::Index>(j)] =
-          std::clamp(frontier.local[j], frontier.median - 4.0 * frontier.mean_gap,
-                     frontier.median + 4.0 * frontier.mean_gap);
-    }
-    const Eigen::VectorXd c = A.colPivHouseholderQr().solve(y);
+    Eigen::VectorXd held(static_cast<Eigen::Index>(m));
+    for (size_t j = 0; j < m; ++j)
+      held[static_cast<Eigen::Index>(j)] = std::clamp(frontier.local[j], frontier.median - 4.0 * frontier.mean_gap,
+                                                      frontier.median + 4.0 * frontier.mean_gap);
+    const Polynomial recess = fitPolynomial(frontier.centre, held, deg);
+    const double first = frontier.centre.front(), last = frontier.centre.back();
     for (size_t i = 0; i < e.points.size(); ++i) {
-      const double u = std::clamp((e.s[i] - mid) / half, -1.0, 1.0);  // held at the end windows' value beyond them
-      double uk = 1, d = 0;
-      for (int k = 0; k <= deg; ++k, uk *= u) d += c[k] * uk;
+      const double d = recess.at(std::clamp(e.s[i], first, last))[0];  // held at the end windows' value beyond them
       e.points[i] -= std::clamp(d, 0.0, strip) * inward[i];
     }
     sigma_recess = frontier.mean_gap * std::sqrt(static_cast<double>(deg + 1) / static_cast<double>(m));
