@@ -153,11 +153,9 @@ struct PointGrid::Impl {
     cell = std::max(cell_m, (hi - lo).maxCoeff() / static_cast<double>(kCoordLimit - 2));
     inv = 1.0 / cell;
 
-    size_t slots = 16;
-    while (slots < 2 * pts.size()) slots *= 2;
-    slot_shift = 64 - static_cast<int>(std::log2(static_cast<double>(slots)) + 0.5);
-    slot_key.assign(slots, kEmptySlot);
-    slot_cell.assign(slots, 0);
+    // The table grows with the cells (at most half full), not with the points: a
+    // few thousand cells' table stays in cache while every point looks its cell up.
+    setSlots(16);
     std::vector<uint32_t> cell_of(pts.size());
     std::vector<uint32_t> count;
     for (size_t i = 0; i < pts.size(); ++i) {
@@ -173,6 +171,7 @@ struct PointGrid::Impl {
       }
       cell_of[i] = slot_cell[s];
       ++count[slot_cell[s]];
+      if (2 * count.size() > slot_key.size()) setSlots(2 * slot_key.size());
     }
     // Cells in Morton (Z-curve) order of their coordinates: cells near in space
     // are near in memory, so the 27 cells around a query and the next cell's
@@ -233,6 +232,21 @@ struct PointGrid::Impl {
            (static_cast<uint64_t>(c.z()) << (2 * kCoordBits));
   }
   size_t slotOf(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> slot_shift); }
+  // Resizes the table to `slots` (a power of two) and puts the stored cells back.
+  void setSlots(size_t slots) {
+    std::vector<uint64_t> old_key(slots, kEmptySlot);
+    std::vector<uint32_t> old_cell(slots, 0);
+    old_key.swap(slot_key);
+    old_cell.swap(slot_cell);
+    slot_shift = 64 - static_cast<int>(std::log2(static_cast<double>(slots)) + 0.5);
+    for (size_t o = 0; o < old_key.size(); ++o) {
+      if (old_key[o] == kEmptySlot) continue;
+      size_t s = slotOf(old_key[o]);
+      while (slot_key[s] != kEmptySlot) s = (s + 1) & (slots - 1);
+      slot_key[s] = old_key[o];
+      slot_cell[s] = old_cell[o];
+    }
+  }
   // The cell at c, or -1 when no point lies there.
   long find(const Eigen::Vector3i& c) const {
     for (int a = 0; a < 3; ++a)
