@@ -16,12 +16,6 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-std::string num(double v, int precision = 3) {
-  char b[64];
-  std::snprintf(b, sizeof(b), "%.*f", precision, v);
-  return b;
-}
-
 double angleDeg(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) / kDeg; }
 double lineAngleDeg(const Vec3& a, const Vec3& b) { return std::acos(std::min(1.0, std::abs(a.dot(b)))) / kDeg; }
 double det3(const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); }
@@ -199,7 +193,7 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
   }
   if (candidates.empty())
     throw AnalysisError(std::string("[registerToBoat] no three planes of the cloud match the faces of '") + ref.name +
-                        "' within " + num(tol, 1) + "°" +
+                        "' within " + formatFixed(tol, 1) + "°" +
                         (any_consistent ? " and the prior orientation" : "") + " (" + std::to_string(D.size()) +
                         " planes found)");
   std::sort(candidates.begin(), candidates.end(), [](const auto& x, const auto& y) {
@@ -270,8 +264,8 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
   out.transform = t;
   out.below_uncertainty = out.fitness_rms_m <= p.uncertainty_m;
   if (!out.below_uncertainty)
-    out.warnings.push_back("planes lie " + num(out.fitness_rms_m * 1000, 1) + " mm RMS off their faces, above the " +
-                           num(p.uncertainty_m * 1000, 1) + " mm uncertainty");
+    out.warnings.push_back("planes lie " + formatFixed(out.fitness_rms_m * 1000, 1) + " mm RMS off their faces, above the " +
+                           formatFixed(p.uncertainty_m * 1000, 1) + " mm uncertainty");
   out.accepted = out.accepted && out.below_uncertainty && !out.ambiguous;
   return out;
 }

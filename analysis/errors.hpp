@@ -1,6 +1,7 @@
 #pragma once
 // Exceptions thrown across the project. Messages name the function (or file)
 // and the offending value: "[growRegions] k_neighbours must be >= 3 (got 0)".
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -20,5 +21,12 @@ struct FileError : std::runtime_error {
 struct AnalysisError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// `v` with `digits` decimals, for messages: formatFixed(0.0123) is "0.012".
+inline std::string formatFixed(double v, int digits = 3) {
+  char b[64];
+  std::snprintf(b, sizeof(b), "%.*f", digits, v);
+  return b;
+}
 
 }  // namespace sailshape

@@ -14,13 +14,7 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-std::string num(double v, int precision = 3) {
-  char b[64];
-  std::snprintf(b, sizeof(b), "%.*f", precision, v);
-  return b;
-}
-
-std::string vecText(const Vec3& v) { return "(" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + ")"; }
+std::string vecText(const Vec3& v) { return "(" + formatFixed(v.x()) + ", " + formatFixed(v.y()) + ", " + formatFixed(v.z()) + ")"; }
 
 std::string describePlanes(const std::vector<DetectedPlane>& planes) {
   if (planes.empty()) return "none";
@@ -97,7 +91,7 @@ size_t planeNearest(const Cloud& cloud, const std::vector<DetectedPlane>& planes
     }
   if (best == planes.size() || best_d2 > 0.25 * 0.25)
     throw AnalysisError(std::string("[registerClouds] no plane of the ") + which + " cloud lies near the hint " +
-                        vecText(point) + " (nearest plane point " + num(std::sqrt(best_d2)) + " m away)");
+                        vecText(point) + " (nearest plane point " + formatFixed(std::sqrt(best_d2)) + " m away)");
   return best;
 }
 
@@ -166,7 +160,7 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
   if (ref_sets.empty() || (!p.plane_hints.empty() && !independent(R, ref_sets[0])))
     throw AnalysisError("[registerClouds] the reference cloud's planes are parallel or their normals share one "
                         "plane (found " + describePlanes(R) + "): the plane method needs " + need_text + " at least " +
-                        num(m.min_plane_angle_deg, 0) +
+                        formatFixed(m.min_plane_angle_deg, 0) +
                         "° apart; parallel planes leave the rotation about their normal and the translation along "
                         "them undetermined");
   if (!p.plane_hints.empty() && !independent(M, mov_sets_hinted[0]))
@@ -284,7 +278,7 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
   if (candidates.empty())
     throw AnalysisError(std::string("[registerClouds] no ") + (need == 3 ? "three" : "two") +
                         " planes of the moving cloud match the angles between the reference planes within " +
-                        num(tol, 1) + "° (" + (any_moving_set ? "the third normal disagreed" : "no consistent set") +
+                        formatFixed(tol, 1) + "° (" + (any_moving_set ? "the third normal disagreed" : "no consistent set") +
                         "; reference: " + describePlanes(R) + "; moving: " + describePlanes(M) +
                         ") — give plane hints or picked pairs");
   std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
@@ -310,8 +304,8 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
       break;
     out.ambiguous = true;
     out.warnings.push_back("ambiguous plane match: another alignment " +
-                           num(rotationDifferenceDeg(best.transform.linear(), candidates[i].transform.linear()), 1) +
-                           "° and " + num((best.transform.translation() - candidates[i].transform.translation()).norm()) +
+                           formatFixed(rotationDifferenceDeg(best.transform.linear(), candidates[i].transform.linear()), 1) +
+                           "° and " + formatFixed((best.transform.translation() - candidates[i].transform.translation()).norm()) +
                            " m away puts as many planes (" + std::to_string(best.planes_on) + ") and " +
                            std::to_string(candidates[i].score) + " sampled points (best " + std::to_string(best.score) +
                            ") on the reference; give plane hints or a picked pair");
@@ -395,8 +389,8 @@ Registration registerClouds(const Cloud& reference, const Cloud& moving, const R
     if (fit.reflection_corrected)
       out.warnings.push_back("the picked pairs fit a reflection best; the nearest rotation was used — check the pairs");
     if (fit.rms_m > p.uncertainty_m)
-      out.warnings.push_back("picked pairs disagree by " + num(fit.rms_m * 1000, 1) + " mm RMS, above the " +
-                             num(p.uncertainty_m * 1000, 1) + " mm uncertainty (picking error)");
+      out.warnings.push_back("picked pairs disagree by " + formatFixed(fit.rms_m * 1000, 1) + " mm RMS, above the " +
+                             formatFixed(p.uncertainty_m * 1000, 1) + " mm uncertainty (picking error)");
   } else {
     // Plain ICP from the raw pose: wide correspondences over both whole clouds.
     IcpParams ip = p.icp;
@@ -418,7 +412,7 @@ Registration registerClouds(const Cloud& reference, const Cloud& moving, const R
     throw AnalysisError("[registerClouds] no overlap: after the " + p.method + " alignment only " +
                         std::to_string(overlap.moving.size()) + " moving and " +
                         std::to_string(overlap.reference.size()) + " reference points have a point of the other cloud within " +
-                        num(p.crossed_radius_m) + " m (need " + std::to_string(p.min_overlap_points) +
+                        formatFixed(p.crossed_radius_m) + " m (need " + std::to_string(p.min_overlap_points) +
                         "); the clouds must see some of the same surfaces");
   const Cloud mov_overlap = selectPoints(moving, overlap.moving);
   out.before_refinement = nearestDistanceStats(reference, transformCloud(mov_overlap, coarse));
@@ -448,12 +442,12 @@ Registration registerClouds(const Cloud& reference, const Cloud& moving, const R
   out.below_uncertainty = fit.points > 0 && out.fitness_rms_m <= p.uncertainty_m;
   for (PlanePairing& pp : out.pairings) pp.angle_after_deg = angleDeg(out.rotation * pp.moving_normal, pp.reference_normal);
   if (!out.below_uncertainty)
-    out.warnings.push_back("fitness " + num(out.fitness_rms_m * 1000, 1) + " mm RMS is above the sensor uncertainty (" +
-                           num(p.uncertainty_m * 1000, 1) + " mm): the registration is not good enough");
+    out.warnings.push_back("fitness " + formatFixed(out.fitness_rms_m * 1000, 1) + " mm RMS is above the sensor uncertainty (" +
+                           formatFixed(p.uncertainty_m * 1000, 1) + " mm): the registration is not good enough");
   if (out.inlier_fraction < p.min_inlier_fraction)
-    out.warnings.push_back("only " + num(100 * out.inlier_fraction, 1) + " % of the overlapping points lie within " +
-                           num(p.uncertainty_m * 1000, 1) + " mm of the reference surface (need " +
-                           num(100 * p.min_inlier_fraction, 0) + " %): surfaces cross rather than coincide");
+    out.warnings.push_back("only " + formatFixed(100 * out.inlier_fraction, 1) + " % of the overlapping points lie within " +
+                           formatFixed(p.uncertainty_m * 1000, 1) + " mm of the reference surface (need " +
+                           formatFixed(100 * p.min_inlier_fraction, 0) + " %): surfaces cross rather than coincide");
   out.accepted = out.below_uncertainty && out.inlier_fraction >= p.min_inlier_fraction && out.converged && !out.ambiguous;
   return out;
 }

@@ -18,12 +18,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string fmt(double v, int digits = 3) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
-
 // The longest closed loop of boundary edges: directed edges a→b used by exactly
 // one triangle whose reverse b→a no triangle uses. Edges are bucketed by their
 // lower vertex (counting sort, linear in the mesh) instead of hashed: the mesh
@@ -748,7 +742,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
     if (far) picked.push_back(i);
   }
   if (picked.size() < 3)
-    throw AnalysisError("[extractOutline] the boundary (" + fmt(total, 2) + " m) has fewer than 3 distinct corners");
+    throw AnalysisError("[extractOutline] the boundary (" + formatFixed(total, 2) + " m) has fewer than 3 distinct corners");
   size_t count = p.corners;
   if (count == 0) {
     // A 4th corner must turn sharply and stand clear of the others: a square
@@ -883,9 +877,9 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
       if (!(design > 0)) continue;
       const double off = std::abs(measured[i] - design) / design;
       if (off > p.design_tolerance)
-        throw AnalysisError(std::string("[extractOutline] ") + names[i] + " length " + fmt(measured[i]) + " m is " +
-                            fmt(100 * off, 1) + " % off the design " + fmt(design) + " m (limit " +
-                            fmt(100 * p.design_tolerance, 0) + " %): corners or segmentation are wrong");
+        throw AnalysisError(std::string("[extractOutline] ") + names[i] + " length " + formatFixed(measured[i]) + " m is " +
+                            formatFixed(100 * off, 1) + " % off the design " + formatFixed(design) + " m (limit " +
+                            formatFixed(100 * p.design_tolerance, 0) + " %): corners or segmentation are wrong");
     }
   }
   return out;

@@ -53,33 +53,29 @@ void writeWholeFile(const std::string& path, const std::string& content) {
   if (!out) throw fileError(path, "write failed");
 }
 
-void splitWhitespace(std::string_view line, std::vector<std::string_view>& tokens) {
+namespace {
+// Tokens between blanks; with `separators`, a ',' or ';' (blanks around it
+// allowed) also ends a token.
+void splitTokens(std::string_view line, std::vector<std::string_view>& tokens, bool separators) {
   tokens.clear();
   const char* p = line.data();
   const char* end = p + line.size();
+  auto separator = [&](char c) { return separators && (c == ',' || c == ';'); };
   while (true) {
     while (p < end && isBlank(*p)) ++p;
     if (p == end) return;
     const char* start = p;
-    while (p < end && !isBlank(*p)) ++p;
+    while (p < end && !isBlank(*p) && !separator(*p)) ++p;
     tokens.emplace_back(start, static_cast<size_t>(p - start));
+    while (p < end && isBlank(*p)) ++p;
+    if (p < end && separator(*p)) ++p;
   }
 }
+}  // namespace
 
-void splitFields(std::string_view line, std::vector<std::string_view>& tokens) {
-  tokens.clear();
-  const char* p = line.data();
-  const char* end = p + line.size();
-  while (true) {
-    while (p < end && isBlank(*p)) ++p;
-    if (p == end) return;
-    const char* start = p;
-    while (p < end && !isBlank(*p) && *p != ',' && *p != ';') ++p;
-    tokens.emplace_back(start, static_cast<size_t>(p - start));
-    while (p < end && isBlank(*p)) ++p;
-    if (p < end && (*p == ',' || *p == ';')) ++p;
-  }
-}
+void splitWhitespace(std::string_view line, std::vector<std::string_view>& tokens) { splitTokens(line, tokens, false); }
+
+void splitFields(std::string_view line, std::vector<std::string_view>& tokens) { splitTokens(line, tokens, true); }
 
 Parsed parseNumber(std::string_view token, double& value) {
   const char* b = token.data();
