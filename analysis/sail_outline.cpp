@@ -1,10 +1,10 @@
 #include "analysis/sail_outline.hpp"
 
 #include <algorithm>
-#include <unordered_map>
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <unordered_map>
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
@@ -18,10 +18,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The longest closed loop of boundary edges: directed edges a→b used by exactly
-// one triangle whose reverse b→a no triangle uses. Edges are bucketed by their
-// lower vertex (counting sort, linear in the mesh) instead of hashed: the mesh
-// of a 200,000-point scan has 1.2 million directed edges.
 // The simple loops a closed walk is made of: the walk cut at each vertex it
 // returns to. A vertex may be passed more than once; each pass closes the loop
 // since the last.
@@ -45,6 +41,10 @@ std::vector<std::vector<uint32_t>> simpleLoops(const std::vector<uint32_t>& walk
   return loops;
 }
 
+// The longest closed loop of boundary edges: directed edges a→b used by exactly
+// one triangle whose reverse b→a no triangle uses. Edges are bucketed by their
+// lower vertex (counting sort, linear in the mesh) instead of hashed: the mesh
+// of a 200,000-point scan has 1.2 million directed edges.
 std::vector<uint32_t> outerBoundaryLoop(const Mesh& mesh) {
   const size_t nv = mesh.vertices.size();
   // Each undirected edge under its lower vertex: the other vertex and whether the
