@@ -69,6 +69,7 @@ ScannerEmulator::ScannerEmulator(const Scene& scene, const ScannerEmulatorParams
       sensor_(scene, params.sensor),
       turntable_(turntable),
       epoch_(turntable ? turntable->epoch() : Clock::now()),
+      ready_at_(Clock::now() + std::chrono::microseconds(roundToInt(std::max(0.0, params.spin_up_s) * 1e6))),
       session_(std::make_unique<Session>()) {
   const ScannerSpec spec = sensor_.spec();
   session_->frequency = static_cast<uint32_t>(std::lround(spec.default_frequency_hz * 100));
@@ -177,6 +178,9 @@ void ScannerEmulator::runSession(int fd) {
         if (!out.empty() && !sendAll(frameCola(binary ? ColaDialect::kBinary : ColaDialect::kAscii, out))) return;
       }
     }
+    // Due as the stream now stands: a request just read may have started it (or the spin-up holds it).
+    if (s.streaming && s.measuring)
+      due = s.stream_start + std::chrono::microseconds(roundToInt((s.next_scan + 1) * period_s * 1e6));
     if (s.streaming && s.measuring && Clock::now() >= due) {
       const Clock::time_point scan_start =
           s.stream_start + std::chrono::microseconds(roundToInt(s.next_scan * period_s * 1e6));
@@ -293,7 +297,7 @@ std::string ScannerEmulator::reply(const std::string& request, bool binary) {
     if (s.access_level < 2) return fail(kErrAccessDenied);
     if (t.name == "LMCstartmeas") {
       if (!s.measuring) {
-        s.stream_start = Clock::now();
+        s.stream_start = std::max(Clock::now(), ready_at_);  // a starting device streams nothing yet
         s.next_scan = 0;
       }
       s.measuring = true;
@@ -332,7 +336,7 @@ std::string ScannerEmulator::reply(const std::string& request, bool binary) {
 
   if (t.type == "sRN") {
     if (t.name == "FirmwareVersion") return out("sRA", w.string(lms111 ? "V1.80.2  " : "V1.80    "));
-    if (t.name == "SCdevicestate") return out("sRA", w.u8(1));  // 1 = ready
+    if (t.name == "SCdevicestate") return out("sRA", w.u8(Clock::now() < ready_at_ ? 0 : 1));  // 0 busy, 1 ready
     if (t.name == "ODoprh") return out("sRA", w.u32(lms111 ? 0x456 : 0x4ab));
     if (t.name == "ODpwrc") return out("sRA", w.u32(lms111 ? 0x3f : 0x63));
     if (t.name == "LocationName") return out("sRA", w.string(lms111 ? "not defined" : "SN 18110550"));
@@ -412,7 +416,7 @@ std::string ScannerEmulator::reply(const std::string& request, bool binary) {
     const uint8_t on = in.u8("enable");
     if (t.name == "LMDscandata") {
       if (on && !s.streaming) {
-        s.stream_start = Clock::now();
+        s.stream_start = std::max(Clock::now(), ready_at_);  // a starting device streams nothing yet
         s.next_scan = 0;
       }
       s.streaming = on != 0;

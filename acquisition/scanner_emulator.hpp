@@ -29,6 +29,9 @@ struct ScannerEmulatorParams {
   double theta_rad = 0.0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   uint32_t serial_number = 0;              // 0: the recorded unit's (LMS111 18090362, LMS511 18110550)
+  // Seconds after power-on (the emulator's construction) during which the device is still starting: it
+  // answers SCdevicestate 0 (busy), as the recorded units did, and streams no scan before then.
+  double spin_up_s = 0.0;
   // Faults, for the client's tests.
   bool refuse_login = false;               // SetAccessMode answers 0
   bool mute = false;                       // accepts and reads, never answers
@@ -63,6 +66,7 @@ class ScannerEmulator {
   EmulatedSensor sensor_;
   TurntableMotion* turntable_;
   std::chrono::steady_clock::time_point epoch_;
+  std::chrono::steady_clock::time_point ready_at_;  // power-on + spin_up_s
   int listen_fd_ = -1;
   uint16_t port_ = 0;
   std::atomic<bool> stop_{false};

@@ -104,6 +104,22 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     scanner.request("sWN", "LMDscandatacfg", w.bytes());
   }
 
+  // The move waits for the scans: a unit still spinning up streams nothing yet.
+  {
+    const double since = hostTimeSeconds(), deadline = since + options.ready_timeout_s;
+    for (;;) {
+      const double left = deadline - hostTimeSeconds();
+      if (left <= 0)
+        throw ScannerError("[runSweep] " + unit.name + ": the scanner streamed no scan within " +
+                           std::to_string(static_cast<int>(std::lround(options.ready_timeout_s))) +
+                           " s of its start-up (device state " + std::to_string(startup.device_state) +
+                           (startup.device_state == 0 ? ", busy" : "") + ")");
+      const ScanBatch first = scanner.receiveScans(1, left);
+      if (!first.scans.empty()) break;
+      if (first.connection_lost) throw ScannerError("[runSweep] " + unit.name + ": " + first.message);
+      progress("scanner starting", std::clamp((hostTimeSeconds() - since) / options.ready_timeout_s, 0.0, 1.0));
+    }
+  }
   if (options.wait_for_start) sweep.trigger_time_s = options.wait_for_start();
 
   std::vector<ReceivedScan> scans;

@@ -21,6 +21,9 @@ struct SweepOptions {
   double positioning_speed_deg_s = 45;  // to the start angle
   double reply_timeout_s = 5;        // scanner replies
   double scan_timeout_s = 2;         // longest gap between streamed scans
+  // Longest wait, after the scanner's start-up, for its first streamed scan: a unit still starting (the
+  // recorded ones answered "busy" then) streams nothing, and a sweep moved meanwhile would lose its start.
+  double ready_timeout_s = 15;
   std::string capture_path;          // raw telegrams with time stamps (empty: none); must not exist
   // Called once the unit stands at its start angle with scans streaming, just before the sweep move;
   // returns the trigger's time (host seconds) to record, e.g. by waiting for a UDP trigger.

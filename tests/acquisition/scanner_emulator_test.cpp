@@ -264,6 +264,30 @@ TEST(ScannerEmulator, Faults) {
   EXPECT_THROW(ScannerEmulator(wallScene(), p), std::runtime_error);
 }
 
+// A unit still starting answers "busy" (the recorded units said 0 then) and streams nothing; once its
+// spin-up is over it answers "ready" and the stream begins.
+TEST(ScannerEmulator, AStartingUnitIsBusyAndStreamsOnlyOnceReady) {
+  ScannerEmulatorParams p = params(ScannerModel::Lms511);
+  p.spin_up_s = 1.0;
+  const auto power_on = std::chrono::steady_clock::now();
+  ScannerEmulator emu(wallScene(), p);
+  RawCola cola(emu.port(), ColaDialect::kBinary);
+  cola.send("sRN SCdevicestate");
+  EXPECT_EQ(splitColaTelegram(cola.next()).arguments, std::string(1, '\0'));  // busy
+  cola.send(colaPayload("sMN", "SetAccessMode", ColaWriter(ColaDialect::kBinary).u8(3).u32(0xF4724744u).bytes()));
+  cola.next();
+  cola.send("sMN LMCstartmeas");
+  cola.next();
+  cola.send(colaPayload("sEN", "LMDscandata", ColaWriter(ColaDialect::kBinary).u8(1).bytes()));
+  cola.next();
+  EXPECT_FALSE(cola.next(2.0).empty()) << "no scan after the spin-up";
+  const double first_scan_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - power_on).count();
+  EXPECT_GE(first_scan_s, 1.0) << "a scan came before the unit was ready";
+  EXPECT_EQ(emu.scansSent(), 1u);
+  cola.send("sRN SCdevicestate");
+  EXPECT_EQ(splitColaTelegram(cola.next(3.0, "sSN")).arguments, std::string(1, '\1'));  // ready
+}
+
 TEST(ScannerEmulator, BetaFollowsTheTurntable) {
   // p = 0, θ = 0: at β the beam at α = 90° points along (0, cos β, sin β); a floor at z = -2 is met
   // at r = 2 / sin(-β) for β < 0.

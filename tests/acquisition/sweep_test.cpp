@@ -209,6 +209,39 @@ TEST(Sweep, ConnectionDroppedMidSweepKeepsThePartialSweep) {
   EXPECT_LT(s.beta_end_deg, 20.0);
 }
 
+// A unit still spinning up streams nothing (the recorded units answered "busy" while starting): the
+// move waits for its first scan, so the sweep still starts at its start angle. Moved at once, the
+// 1 s sweep would be over before the first scan, 2.5 s after power-on.
+TEST(Sweep, TheMoveWaitsForAUnitThatIsStillStarting) {
+  UnitConfig u = compactUnit(0.1, 0);
+  ScannerEmulatorParams sp = emulatorFor(u);
+  sp.spin_up_s = 2.5;
+  Rig rig(wallAt(3), u, sp, fastTable());
+  const Sweep s = runSweep(rig.unit);
+  ASSERT_FALSE(s.partial) << s.message;
+  EXPECT_NEAR(s.beta_start_deg, -20, 1.0);
+  EXPECT_NEAR(s.beta_end_deg, 20, 1.0);
+  EXPECT_GE(s.scans, 40u);
+}
+
+// One that never gets ready within the wait: one error naming the wait and the device's state.
+TEST(Sweep, AUnitThatNeverStartsStreamingIsReported) {
+  UnitConfig u = compactUnit(0.1, 0);
+  ScannerEmulatorParams sp = emulatorFor(u);
+  sp.spin_up_s = 30;
+  Rig rig(wallAt(3), u, sp, fastTable());
+  SweepOptions o;
+  o.ready_timeout_s = 1;
+  try {
+    runSweep(rig.unit, o);
+    ADD_FAILURE() << "a sweep cannot run without scans";
+  } catch (const ScannerError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("streamed no scan within 1 s"), std::string::npos) << what;
+    EXPECT_NE(what.find("device state 0, busy"), std::string::npos) << what;
+  }
+}
+
 TEST(Sweep, TurntableThatNeverFindsHome) {
   EmulatedTurntableParams tp = fastTable();
   tp.home_sensor_works = false;
