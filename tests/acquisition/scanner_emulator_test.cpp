@@ -137,6 +137,16 @@ void answersLikeTheRecordedDevice(ScannerModel model, const std::string& file) {
   EXPECT_EQ(d.version, model == ScannerModel::Lms111 ? 1 : 0);
 }
 
+// Log in, start measuring and switch the stream on, in CoLa B, each reply read.
+void startStreaming(RawCola& cola) {
+  cola.send(colaPayload("sMN", "SetAccessMode", ColaWriter(ColaDialect::kBinary).u8(3).u32(0xF4724744u).bytes()));
+  cola.next();
+  cola.send("sMN LMCstartmeas");
+  cola.next();
+  cola.send(colaPayload("sEN", "LMDscandata", ColaWriter(ColaDialect::kBinary).u8(1).bytes()));
+  cola.next();
+}
+
 }  // namespace
 
 TEST(ScannerEmulator, Lms111AnswersTheRecordedStartupSequence) {
@@ -248,12 +258,7 @@ TEST(ScannerEmulator, Faults) {
   {
     ScannerEmulator emu(wallScene(), p);
     RawCola cola(emu.port(), ColaDialect::kBinary);
-    cola.send(colaPayload("sMN", "SetAccessMode", ColaWriter(ColaDialect::kBinary).u8(3).u32(0xF4724744u).bytes()));
-    cola.next();
-    cola.send("sMN LMCstartmeas");
-    cola.next();
-    cola.send(colaPayload("sEN", "LMDscandata", ColaWriter(ColaDialect::kBinary).u8(1).bytes()));
-    cola.next();
+    startStreaming(cola);
     int scans = 0;
     while (!cola.next(2.0).empty()) ++scans;
     EXPECT_EQ(scans, 3);
@@ -274,12 +279,7 @@ TEST(ScannerEmulator, AStartingUnitIsBusyAndStreamsOnlyOnceReady) {
   RawCola cola(emu.port(), ColaDialect::kBinary);
   cola.send("sRN SCdevicestate");
   EXPECT_EQ(splitColaTelegram(cola.next()).arguments, std::string(1, '\0'));  // busy
-  cola.send(colaPayload("sMN", "SetAccessMode", ColaWriter(ColaDialect::kBinary).u8(3).u32(0xF4724744u).bytes()));
-  cola.next();
-  cola.send("sMN LMCstartmeas");
-  cola.next();
-  cola.send(colaPayload("sEN", "LMDscandata", ColaWriter(ColaDialect::kBinary).u8(1).bytes()));
-  cola.next();
+  startStreaming(cola);
   EXPECT_FALSE(cola.next(2.0).empty()) << "no scan after the spin-up";
   const double first_scan_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - power_on).count();
   EXPECT_GE(first_scan_s, 1.0) << "a scan came before the unit was ready";
