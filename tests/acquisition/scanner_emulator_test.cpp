@@ -273,17 +273,16 @@ TEST(ScannerEmulator, Faults) {
 // spin-up is over it answers "ready" and the stream begins.
 TEST(ScannerEmulator, AStartingUnitIsBusyAndStreamsOnlyOnceReady) {
   ScannerEmulatorParams p = params(ScannerModel::Lms511);
-  p.spin_up_s = 1.0;
+  p.spin_up_s = 1.5;
   const auto power_on = std::chrono::steady_clock::now();
   ScannerEmulator emu(wallScene(), p);
   RawCola cola(emu.port(), ColaDialect::kBinary);
   cola.send("sRN SCdevicestate");
   EXPECT_EQ(splitColaTelegram(cola.next()).arguments, std::string(1, '\0'));  // busy
   startStreaming(cola);
-  EXPECT_FALSE(cola.next(2.0).empty()) << "no scan after the spin-up";
+  EXPECT_FALSE(cola.next(4.0).empty()) << "no scan after the spin-up";
   const double first_scan_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - power_on).count();
-  EXPECT_GE(first_scan_s, 1.0) << "a scan came before the unit was ready";
-  EXPECT_EQ(emu.scansSent(), 1u);
+  EXPECT_GE(first_scan_s, 1.5) << "a scan came before the unit was ready";
   cola.send("sRN SCdevicestate");
   EXPECT_EQ(splitColaTelegram(cola.next(3.0, "sSN")).arguments, std::string(1, '\1'));  // ready
 }
