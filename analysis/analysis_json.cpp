@@ -74,7 +74,10 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
   for (const ClusterInfo& c : a.clusters)
     clusters.push_back({{"points", c.points},
                         {"extent_m", c.extent_m},
+                        {"width_m", c.width_m},
                         {"plane_rms_m", c.plane_rms_m},
+                        {"bend_rms_m", c.bend_rms_m},
+                        {"rough_rms_m", c.rough_rms_m},
                         {"tilt_from_vertical_deg", c.tilt_from_vertical_deg},
                         {"sail_like", c.sail_like},
                         {"reason", c.reason}});

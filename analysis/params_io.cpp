@@ -14,7 +14,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(NormalParams, k_neighbours, orie
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegionGrowingParams, k_neighbours, max_normal_angle_deg, max_curvature,
                                                 min_points, max_points)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SailPickParams, method, seed_point, cluster_index, min_depth_m,
-                                                min_depth_ratio, min_extent_m, max_tilt_deg)
+                                                min_depth_ratio, min_extent_m, max_tilt_deg, min_width_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SparSearchParams, min_radius_m, max_radius_m, min_length_radii,
                                                 min_arc_deg, min_support, hypotheses, max_spars, seed)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StatisticalOutlierParams, k_neighbours, std_ratio)

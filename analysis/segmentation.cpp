@@ -178,6 +178,39 @@ std::vector<uint32_t> addClusterFringe(const Segmentation& seg, size_t cluster, 
   return members;
 }
 
+namespace {
+
+// A cluster's spread off its best-fit plane, split into what a quadratic height
+// field over the plane takes away (the bend) and what stays (the roughness):
+// bend² + roughness² = the plane's mean square. `axes` are the cluster's principal
+// directions (covariance eigenvectors, smallest first); `extent_m` scales the plane
+// coordinates to about ±1 for a well-conditioned fit.
+struct PlaneSpread {
+  double bend_rms_m = 0, rough_rms_m = 0;
+};
+
+PlaneSpread splitPlaneSpread(const Cloud& cloud, const std::vector<uint32_t>& cluster, const Vec3& mean,
+                             const Eigen::Matrix3d& axes, double extent_m) {
+  const double s = 1.0 / std::max(1e-9, extent_m);
+  Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
+  double hh = 0;
+  for (uint32_t i : cluster) {
+    const Vec3 d = cloud.points[i] - mean;
+    const double u = s * d.dot(axes.col(2)), v = s * d.dot(axes.col(1)), h = d.dot(axes.col(0));
+    Eigen::Matrix<double, 6, 1> row;
+    row << 1, u, v, u * u, u * v, v * v;
+    ata.noalias() += row * row.transpose();
+    atb += h * row;
+    hh += h * h;
+  }
+  const double n = static_cast<double>(cluster.size());
+  const double left = std::max(0.0, hh - ata.ldlt().solve(atb).dot(atb)) / n;
+  return {std::sqrt(std::max(0.0, hh / n - left)), std::sqrt(left)};
+}
+
+}  // namespace
+
 SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const SailPickParams& p) {
   if (seg.clusters.empty()) throw AnalysisError("[pickSailCluster] segmentation found no cluster to pick a sail from");
   SailPick pick;
@@ -198,13 +231,19 @@ SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const Sail
     info.plane_normal = eig.eigenvectors().col(0);
     info.plane_rms_m = std::sqrt(std::max(0.0, eig.eigenvalues()[0]));
     info.extent_m = 4.0 * std::sqrt(std::max(0.0, eig.eigenvalues()[2]));
+    info.width_m = 4.0 * std::sqrt(std::max(0.0, eig.eigenvalues()[1]));
+    const PlaneSpread spread = splitPlaneSpread(cloud, cluster, mean, eig.eigenvectors(), info.extent_m);
+    info.bend_rms_m = spread.bend_rms_m;
+    info.rough_rms_m = spread.rough_rms_m;
     info.tilt_from_vertical_deg = std::asin(std::min(1.0, std::abs(info.plane_normal.z()))) * 180.0 / kPi;
     const double depth_needed = std::max(p.min_depth_m, p.min_depth_ratio * info.extent_m);
     if (info.extent_m < p.min_extent_m) {
       info.reason = "too small";
     } else if (info.tilt_from_vertical_deg > p.max_tilt_deg) {
       info.reason = "lies flat (deck, floor or ceiling)";
-    } else if (info.plane_rms_m < depth_needed) {
+    } else if (info.width_m < p.min_width_ratio * info.extent_m) {
+      info.reason = "narrow (spar or pole)";
+    } else if (info.bend_rms_m < depth_needed) {
       info.reason = "planar (wall or panel)";
     } else {
       info.sail_like = true;

@@ -49,24 +49,37 @@ struct ClusterInfo {
   Vec3 centroid = Vec3::Zero();
   Vec3 plane_normal = Vec3::UnitZ();
   double extent_m = 0;        // largest spread along the plane's principal axis (2 × 2σ)
+  double width_m = 0;         // the same across it, in the plane: a spar's diameter, a sail's chords
   double plane_rms_m = 0;     // RMS distance to the best-fit plane: ~σ for walls, decimetres for sails
+  // Of that spread, what a smooth bend takes away (a quadratic height field over
+  // the plane) and what stays: a sail's depth is the bend, a wall's is noise.
+  double bend_rms_m = 0;
+  double rough_rms_m = 0;
   double tilt_from_vertical_deg = 0;  // 0 for a vertical surface, 90 for deck or floor
   bool sail_like = false;
   std::string reason;         // why it is or is not sail-like
 };
 
-// Auto picks the largest cluster that is curved (plane_rms_m above
-// min_depth_m and min_depth_ratio of its extent), large (extent_m >= min_extent_m)
-// and not lying flat (tilt below max_tilt_deg). A seed point picks the cluster
-// holding the point nearest to it; an index picks that cluster directly.
+// Auto picks the largest cluster that is large (extent_m >= min_extent_m), not
+// lying flat (tilt below max_tilt_deg), not a spar's narrow strip (width_m at least
+// min_width_ratio of its extent) and bent (bend_rms_m at least min_depth_m and
+// min_depth_ratio of its extent). The bend, not the plane's RMS, tells a sail from a
+// wall: a wall's spread off its plane is noise that no smooth bend takes away, while
+// a flat, tall mainsail spreads little more than a wall of its size would by noise
+// and systematic error. A seed point picks the cluster holding the point nearest
+// to it; an index picks that cluster directly.
 struct SailPickParams {
   std::string method = "auto";          // auto | seed | index
   std::vector<double> seed_point;       // [x, y, z] for "seed"
   int cluster_index = 0;                // for "index" (0 = largest)
-  double min_depth_m = 0.02;
-  double min_depth_ratio = 0.005;
+  // 2σ of the sensor: the most a wall's systematic range error bends it (SPEC §3).
+  double min_depth_m = 0.008;
+  // A 10 m mainsail at 3 % camber bends about 2 cm (0.0018 of its 11.5 m extent).
+  double min_depth_ratio = 0.0015;
   double min_extent_m = 0.3;
   double max_tilt_deg = 60.0;
+  // Sails are at least a sixth as wide as tall (a blade jib); a mast is 1 %.
+  double min_width_ratio = 0.08;
 };
 
 struct SailPick {

@@ -338,6 +338,67 @@ TEST(PickSailCluster, AutoChoosesTheCurvedSailOverALargerWallAndFloor) {
   EXPECT_NEAR(sail.tilt_from_vertical_deg, 0.0, 1.0);
 }
 
+TEST(PickSailCluster, AFlatTallMainsailIsPickedOverALargerBowedWall) {
+  // A 10 m × 2.5 m mainsail at 4 % camber (depth D = 0.1 m) spreads 0.298·D ≈ 3 cm
+  // off its plane: under half a percent of its 11.5 m extent, about what a 20 m
+  // wall's systematic errors could spread. The bend tells them apart: a quadratic
+  // takes the sail's parabolic depth away entirely and leaves only the noise, while
+  // the wall's spread is noise but for a 5 mm systematic bow (0.298 × 5 mm ≈ 1.5 mm).
+  Cloud cloud;
+  Segmentation seg;
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::normal_distribution<double> N(0.0, 1.0);
+  std::vector<uint32_t> wall;
+  for (int i = 0; i < 12000; ++i) {
+    const double u = U(rng), z = 3 * U(rng);
+    wall.push_back(static_cast<uint32_t>(cloud.size()));
+    cloud.points.emplace_back(20 * u - 10, 5 + 0.005 * 4 * u * (1 - u) + kSigma * N(rng), z);
+  }
+  seg.clusters.push_back(wall);
+  seg.clusters.push_back(addSailPatch(cloud, 2.5, 10.0, 0.04, 1.0, 8000, kSigma, rng));
+
+  const SailPick pick = pickSailCluster(cloud, seg);
+  EXPECT_EQ(pick.cluster, 1u);
+  const ClusterInfo& w = pick.candidates[0];
+  EXPECT_EQ(w.reason, "planar (wall or panel)");
+  EXPECT_LT(w.bend_rms_m, 0.002);  // 1.5 mm of bow, plus the noise a quadratic picks up
+  EXPECT_NEAR(w.rough_rms_m, kSigma, 0.05 * kSigma);
+  const ClusterInfo& sail = pick.candidates[1];
+  EXPECT_EQ(sail.reason, "curved surface");
+  EXPECT_NEAR(sail.extent_m, 4 * 10 / std::sqrt(12.0), 0.03 * 4 * 10 / std::sqrt(12.0));
+  EXPECT_LT(sail.plane_rms_m, 0.005 * sail.extent_m);  // what a rule on the plane's spread alone would reject
+  EXPECT_NEAR(sail.bend_rms_m, 0.298 * 0.1, 0.05 * 0.298 * 0.1);
+  EXPECT_NEAR(sail.rough_rms_m, kSigma, 0.1 * kSigma);
+  EXPECT_NEAR(sail.width_m, 4 * 2.5 / std::sqrt(12.0), 0.05 * 4 * 2.5 / std::sqrt(12.0));
+}
+
+TEST(PickSailCluster, AMastStandingApartIsNarrowNotASail) {
+  // The scanner's side of a mast 12 m tall and 16 cm across: off its plane the half
+  // cylinder spreads 0.31 r = 2.5 cm and bends like a sail, but it is 0.23 m wide
+  // for its 13.9 m extent. It has more points than the sail and is not picked.
+  PickScene s = pickScene();
+  std::mt19937 rng(44);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::normal_distribution<double> N(0.0, 1.0);
+  const double r = 0.08;
+  std::vector<uint32_t> mast;
+  for (int i = 0; i < 9000; ++i) {
+    const double phi = M_PI * (U(rng) - 0.5), z = 12 * U(rng), rr = r + kSigma * N(rng);
+    mast.push_back(static_cast<uint32_t>(s.cloud.size()));
+    s.cloud.points.emplace_back(1.0 + rr * std::sin(phi), -1.0 - rr * std::cos(phi), z);
+  }
+  s.seg.clusters.insert(s.seg.clusters.begin(), mast);
+
+  const SailPick pick = pickSailCluster(s.cloud, s.seg);
+  EXPECT_EQ(pick.cluster, PickScene::kSail + 1);
+  const ClusterInfo& m = pick.candidates[0];
+  EXPECT_EQ(m.reason, "narrow (spar or pole)");
+  EXPECT_FALSE(m.sail_like);
+  EXPECT_NEAR(m.width_m, 4 * r / std::sqrt(2.0), 0.05 * 4 * r / std::sqrt(2.0));  // r sin φ: σ = r/√2
+  EXPECT_GT(m.bend_rms_m, SailPickParams{}.min_depth_ratio * m.extent_m);  // bent enough to pass for a sail
+}
+
 TEST(PickSailCluster, SeedPicksTheClusterNearestToThePoint) {
   const PickScene s = pickScene();
   SailPickParams p;
