@@ -745,12 +745,12 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
     throw AnalysisError("[extractOutline] the boundary (" + formatFixed(total, 2) + " m) has fewer than 3 distinct corners");
   size_t count = p.corners;
   if (count == 0) {
-    // A 4th corner must turn sharply and stand clear of the others: a square
-    // head is a real edge, not a kink beside the head of a triangular sail.
-    bool clear = picked.size() == 4;
-    for (size_t j = 0; clear && j < 3; ++j) clear = arcDist(picked[3], picked[j]) >= 4.0 * w;
+    // A 4th corner (picked min_sep = 2.5 windows from the others) must turn
+    // sharply: a square head is a real edge, not a kink beside the head of a
+    // triangular sail (those turn under 35° on every sail swept, square heads
+    // over 65°, down to a 0.95 m head on an 11.5 m luff) ...
     // ... and keep turning at twice the scale (a local notch in a noisy edge does not).
-    count = clear && turn[picked[3]] >= p.min_fourth_corner_deg &&
+    count = picked.size() == 4 && turn[picked[3]] >= p.min_fourth_corner_deg &&
                     turnAt(picked[3], 2.0 * w) >= p.min_fourth_corner_deg
                 ? 4
                 : 3;

@@ -111,6 +111,27 @@ TEST(Pipeline, SquareTopPeakStaysWithinTheTargetWhereItsShortTopEdgeIsThinlySamp
   }
 }
 
+TEST(Pipeline, ASquareHeadUnderAMetreWideKeepsItsFourCorners) {
+  // A 0.9 m head on a 12 m luff, 3 % of the 29 m outline. A 4th corner once had to
+  // stand 4 corner windows (1 % of the outline each) from the others, and this
+  // one, 3.0 windows from the head, made the sail a triangle with its head midway
+  // across the top edge. Kinks beside a triangle's head turn under 35°; this
+  // peak turns 70°.
+  SailDesign design = exampleDesign(SailType::SquareTopMain);
+  design.luff_m = 12.0;
+  design.leech_m = 12.1;
+  design.foot_m = 4.0;
+  design.head_width_m = 0.9;
+  const SailSurface truth(design);
+  for (const auto& [noise, seed] : {std::pair{0.0, 1}, {kSigma, 2}}) {
+    SCOPED_TRACE("noise " + std::to_string(noise) + " seed " + std::to_string(seed));
+    const SailAnalysis a = analyzeSail(sampleSail(design, scan(40000, static_cast<uint64_t>(seed), noise)));
+    ASSERT_TRUE(a.outline.has_peak);
+    EXPECT_LT((a.outline.peak - truth.peak()).norm(), kClean.corner_m);
+    EXPECT_LT((a.outline.head - truth.head()).norm(), kClean.corner_m);
+  }
+}
+
 // A clean scan loses no sample. The radius filter drops a gennaker's last samples
 // near its narrow head (few neighbours there); readmission brings them back only
 // if they lie on the surface of the kept points beyond them, and the head curves
