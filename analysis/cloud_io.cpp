@@ -8,6 +8,8 @@
 #include <optional>
 #include <string_view>
 
+#include <lzf.h>
+
 #include "analysis/errors.hpp"
 #include "analysis/ply_format.hpp"
 #include "analysis/text_scan.hpp"
@@ -240,6 +242,7 @@ struct PcdHeader {
   uint64_t points = 0;
   std::optional<Vec3> viewpoint;
   bool binary = false;
+  bool compressed = false;  // binary_compressed: LZF over the fields one after another
   size_t data_offset = 0;
   size_t data_line = 0;
   size_t record_size = 0;
@@ -328,13 +331,14 @@ PcdHeader parsePcdHeader(const std::string& path, const std::string& buf) {
       const bool identity = v[3] == 1 && v[4] == 0 && v[5] == 0 && v[6] == 0;
       if (!(origin && identity)) header.viewpoint = Vec3(v[0], v[1], v[2]);
     } else if (key == "DATA") {
-      if (tok.size() != 2) throw atLine(path, n, "malformed DATA line (expected 'DATA ascii|binary')");
+      if (tok.size() != 2)
+        throw atLine(path, n, "malformed DATA line (expected 'DATA ascii|binary|binary_compressed')");
       if (tok[1] == "ascii")
         header.binary = false;
       else if (tok[1] == "binary")
         header.binary = true;
       else if (tok[1] == "binary_compressed")
-        throw atLine(path, n, "PCD DATA binary_compressed is not supported");
+        header.binary = header.compressed = true;
       else
         throw atLine(path, n, "unknown PCD DATA type " + quoted(tok[1]));
       header.data_line = n;
@@ -390,6 +394,40 @@ PcdHeader parsePcdHeader(const std::string& path, const std::string& buf) {
   return header;
 }
 
+// The fields of a binary_compressed PCD, inflated: after the DATA line come the
+// compressed and the inflated byte counts (uint32 each, little-endian), then the
+// LZF stream of every field's values for all points, field after field.
+std::vector<char> inflatePcd(const std::string& path, const std::string& buf, const PcdHeader& header) {
+  const size_t at = header.data_offset;
+  if (buf.size() - at < 8)
+    throw atByte(path, buf.size(), "truncated binary_compressed data (no size words after the DATA line)");
+  uint32_t packed = 0, unpacked = 0;
+  std::memcpy(&packed, buf.data() + at, 4);
+  std::memcpy(&unpacked, buf.data() + at + 4, 4);
+  if (!kHostLittleEndian) {
+    packed = __builtin_bswap32(packed);
+    unpacked = __builtin_bswap32(unpacked);
+  }
+  const uint64_t expected = header.points * header.record_size;
+  if (unpacked != expected)
+    throw atByte(path, at + 4,
+                 "binary_compressed data inflates to " + std::to_string(unpacked) + " bytes, but " +
+                     std::to_string(header.points) + " points of " + std::to_string(header.record_size) +
+                     " bytes need " + std::to_string(expected));
+  if (packed > buf.size() - at - 8)
+    throw atByte(path, buf.size(),
+                 "truncated binary_compressed data (" + std::to_string(packed) + " compressed bytes announced, " +
+                     std::to_string(buf.size() - at - 8) + " in the file)");
+  std::vector<char> out(unpacked);
+  if (unpacked == 0) return out;
+  const unsigned got = lzf_decompress(buf.data() + at + 8, packed, out.data(), unpacked);
+  if (got != unpacked)
+    throw atByte(path, at + 8,
+                 "corrupt binary_compressed data (LZF " + std::string(got == 0 ? "stream is invalid" : "stream ended early") +
+                     ": " + std::to_string(got) + " of " + std::to_string(unpacked) + " bytes inflated)");
+  return out;
+}
+
 CloudReadResult readPcd(const std::string& path, const std::string& buf) {
   const PcdHeader header = parsePcdHeader(path, buf);
   std::vector<std::string_view> names;
@@ -408,27 +446,39 @@ CloudReadResult readPcd(const std::string& path, const std::string& buf) {
   const size_t bytes_left = buf.size() - header.data_offset;
   double v[kRoleCount] = {};
   if (header.binary) {
+    // Plain binary holds one record per point; binary_compressed (PCL's
+    // savePCDFileBinaryCompressed) holds, once inflated, each field's values for
+    // every point, one field after another.
     const size_t stride = header.record_size;
-    CloudBuilder builder(present, reserveFor(header.points, bytes_left, stride));
-    if (stride > 0 && header.points > bytes_left / stride)
+    std::vector<char> inflated;
+    if (header.compressed) inflated = inflatePcd(path, buf, header);
+    const char* data = header.compressed ? inflated.data() : buf.data() + header.data_offset;
+    const size_t available = header.compressed ? inflated.size() : bytes_left;
+    CloudBuilder builder(present, reserveFor(header.points, available, stride));
+    if (stride > 0 && header.points > available / stride)
       throw atByte(path, buf.size(),
                    "truncated data (expected " + std::to_string(header.points) + " points, got " +
-                       std::to_string(bytes_left / stride) + ")");
-    const char* record = buf.data() + header.data_offset;
+                       std::to_string(available / stride) + ")");
+    auto valueOf = [&](const PcdField& f, uint64_t i) {
+      return header.compressed ? data + header.points * f.byte_offset + i * scalarSize(f.type) * f.count
+                               : data + i * stride + f.byte_offset;
+    };
     const bool swap = !kHostLittleEndian;  // PCL writes little-endian in practice
-    for (uint64_t i = 0; i < header.points; ++i, record += stride) {
+    for (uint64_t i = 0; i < header.points; ++i) {
       for (const auto& [role, field] : used) {
-        const char* p = record + field->byte_offset;
+        const char* p = valueOf(*field, i);
         const double x = loadScalar(p, field->type, swap);
-        if (role <= kZ && std::isinf(x))
-          throw atByte(
-              path, static_cast<size_t>(p - buf.data()),
-              "infinite coordinate (" + std::string(kAxisNames[role]) + " of point " + std::to_string(i) + ")");
+        if (role <= kZ && std::isinf(x)) {
+          const std::string what =
+              "infinite coordinate (" + std::string(kAxisNames[role]) + " of point " + std::to_string(i) + ")";
+          if (header.compressed) throw atLine(path, header.data_line, what + " in the compressed data");
+          throw atByte(path, static_cast<size_t>(p - buf.data()), what);
+        }
         v[role] = x;
       }
       builder.add(v);
     }
-    return builder.finish(path, "pcd-binary", header.viewpoint);
+    return builder.finish(path, header.compressed ? "pcd-binary-compressed" : "pcd-binary", header.viewpoint);
   }
 
   CloudBuilder builder(present, reserveFor(header.points, bytes_left, 2 * header.values_per_point));

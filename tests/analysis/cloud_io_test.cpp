@@ -431,10 +431,69 @@ TEST_F(CloudIoTest, PcdBinaryMixedTypesAndViewpoint) {
   EXPECT_EQ(*r.cloud.viewpoint, Vec3(1, 2, 3));
 }
 
+// Files written by PCL's own savePCDFileBinaryCompressed (tests/analysis/data/README.md).
+std::string pclFile(const std::string& name) { return std::string(SAILSHAPE_TEST_DATA) + "/" + name; }
+
+std::string fileBytes(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST_F(CloudIoTest, PcdBinaryCompressedWrittenByPcl) {
+  const CloudReadResult r = readCloud(pclFile("xyzi_compressed.pcd"));
+  EXPECT_EQ(r.format, "pcd-binary-compressed");
+  ASSERT_EQ(r.cloud.size(), 600u);
+  ASSERT_EQ(r.cloud.intensity.size(), 600u);
+  for (size_t i = 0; i < 600; ++i) {
+    // PCL stored floats: compare with the same float arithmetic.
+    const Vec3 want(0.01f * static_cast<float>(i % 30), 0.02f * static_cast<float>(i / 30), 0.001f * static_cast<float>(i));
+    ASSERT_EQ(r.cloud.points[i], want) << "point " << i;
+    ASSERT_EQ(r.cloud.intensity[i], static_cast<float>(i)) << "point " << i;
+  }
+  ASSERT_TRUE(r.cloud.viewpoint.has_value());
+  EXPECT_EQ(*r.cloud.viewpoint, Vec3(1.5, -2, 3));
+  EXPECT_EQ(r.dropped_nan_points, 0u);
+}
+
+TEST_F(CloudIoTest, PcdBinaryCompressedOrganisedWithAnInvalidReturn) {
+  const CloudReadResult r = readCloud(pclFile("xyz_organised_nan_compressed.pcd"));
+  ASSERT_EQ(r.cloud.size(), 599u);
+  EXPECT_EQ(r.dropped_nan_points, 1u);
+  EXPECT_EQ(r.cloud.points[300], Vec3(0.5 * 0, 0.25 * 15, 1));  // point 300; 301 was NaN
+  EXPECT_EQ(r.cloud.points[301], Vec3(0.5 * 2, 0.25 * 15, 1));  // point 302
+  EXPECT_EQ(r.cloud.points[598], Vec3(0.5 * 19, 0.25 * 29, 1));
+}
+
+TEST_F(CloudIoTest, PcdBinaryCompressedErrors) {
+  const std::string good = fileBytes(pclFile("xyzi_compressed.pcd"));
+  const size_t line = good.find("DATA binary_compressed\n");
+  ASSERT_NE(line, std::string::npos);
+  const size_t data = line + std::strlen("DATA binary_compressed\n");
+  uint32_t packed = 0;
+  std::memcpy(&packed, good.data() + data, 4);
+  ASSERT_EQ(good.size(), data + 8 + packed);  // PCL writes nothing after the stream
+
+  EXPECT_READ_ERROR(write("short.pcd", good.substr(0, good.size() - 100)),
+                    "byte " + std::to_string(good.size() - 100),
+                    "truncated binary_compressed data (" + std::to_string(packed) + " compressed bytes announced, " +
+                        std::to_string(packed - 100) + " in the file)");
+  EXPECT_READ_ERROR(write("nosizes.pcd", good.substr(0, data + 5)),
+                    "truncated binary_compressed data (no size words after the DATA line)");
+  // The stream opens with a literal run; a back reference there points before the
+  // start of the output, which LZF refuses.
+  std::string bad = good;
+  bad[data + 8] = static_cast<char>(0xff);
+  EXPECT_READ_ERROR(write("corrupt.pcd", bad), "byte " + std::to_string(data + 8),
+                    "corrupt binary_compressed data (LZF stream is invalid: 0 of 9600 bytes inflated)");
+  // A header that does not match the stream: 601 points need 9616 bytes.
+  std::string more = good;
+  more.replace(more.find("POINTS 600"), 10, "POINTS 601");
+  EXPECT_READ_ERROR(write("points.pcd", more),
+                    "binary_compressed data inflates to 9600 bytes, but 601 points of 16 bytes need 9616");
+}
+
 TEST_F(CloudIoTest, PcdErrors) {
   const std::string fields = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 5\nHEIGHT 1\n";
-  EXPECT_READ_ERROR(write("compressed.pcd", fields + "POINTS 5\nDATA binary_compressed\n"),
-                    "line 9: PCD DATA binary_compressed is not supported");
   EXPECT_READ_ERROR(write("datatype.pcd", fields + "POINTS 5\nDATA hex\n"), "line 9: unknown PCD DATA type 'hex'");
   EXPECT_READ_ERROR(write("nodata.pcd", fields + "POINTS 5\n"), "line 8: truncated PCD header (no DATA line)");
   EXPECT_READ_ERROR(write("notpcd.pcd", "ply\nformat ascii 1.0\n"),
