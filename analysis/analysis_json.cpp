@@ -28,6 +28,7 @@ nlohmann::json sectionToJson(const Section& s) {
   j["plane_normal"] = vec(s.plane_normal);
   j["plane_tilt_deg"] = s.plane_tilt_deg;
   j["converged"] = s.converged;
+  j["bridged_pct"] = s.bridged_pct;
   nlohmann::json curve = nlohmann::json::array();
   for (const Vec3& p : s.curve) curve.push_back(vec(p));
   j["curve"] = std::move(curve);

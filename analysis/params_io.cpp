@@ -28,7 +28,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(OutlineParams, corners, corner_w
                                                 edge_smoothing_m, design_lengths_m, design_tolerance)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions, plane, end_window, peak_window,
                                                 normal_tolerance_deg, max_tilt_deg, max_iterations, normal_radius,
-                                                noise_correlation_m, curve_points)
+                                                noise_correlation_m, curve_points, max_bridged_gap)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, normals, segment,
                                                 segmentation_voxel_sigmas, region_growing,
                                                 sail_pick, find_spars, spars, statistical_outliers, statistical, radius_outliers, radius,

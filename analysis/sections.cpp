@@ -14,9 +14,21 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = 180.0 / kPi;
 
+// A stretch of a section curve bridged across a hole, chord coordinates (m).
+struct Bridge {
+  double x0 = 0, x1 = 0;
+  double sd = 0;  // how far two fair curves across it disagree: the bridge's 1σ
+};
+
 struct Cut {
   std::vector<Vec3> points;
   std::vector<uint32_t> triangles;  // triangle of segment i → i+1
+  std::vector<Bridge> bridges;      // stretches of `points` that bridge holes
+};
+
+struct Frame {
+  Vec3 L, R, c_hat, y_hat, m;  // luff, leech, chord direction, in-plane normal to chord, plane normal
+  double chord;
 };
 
 // Intersects the mesh with the plane (point q, unit normal m) and returns the
@@ -86,11 +98,38 @@ std::vector<Cut> cutMesh(const Mesh& mesh, const Vec3& q, const Vec3& m) {
   return cuts;
 }
 
+// Slope at x_end of a least-squares line (2 points) or quadratic (more) through
+// the chord-coordinate points within `window` of x_end on one side.
+double sideSlope(const std::vector<Eigen::Vector2d>& xy, double x_end, double window, bool left) {
+  std::vector<Eigen::Vector2d> win;
+  for (const auto& v : xy)
+    if (left ? (v.x() <= x_end && v.x() >= x_end - window) : (v.x() >= x_end && v.x() <= x_end + window))
+      win.push_back(v);
+  if (win.size() < 2) return 0;
+  const int cols = win.size() >= 4 ? 3 : 2;
+  Eigen::MatrixXd A(win.size(), cols);
+  Eigen::VectorXd y(win.size());
+  for (size_t i = 0; i < win.size(); ++i) {
+    const double u = win[i].x() - x_end;
+    A(static_cast<Eigen::Index>(i), 0) = 1;
+    A(static_cast<Eigen::Index>(i), 1) = u;
+    if (cols == 3) A(static_cast<Eigen::Index>(i), 2) = u * u;
+    y[static_cast<Eigen::Index>(i)] = win[i].y();
+  }
+  return A.colPivHouseholderQr().solve(y)[1];
+}
+
 // The section curve from luff to leech: the cut pieces that lie over the chord
 // (within half a chord of it, between its ends), joined in chord order. A cut
 // is normally one piece; holes or non-manifold edges can break it into several.
-bool pickCut(std::vector<Cut>& cuts, const Vec3& L, const Vec3& R, double chord, Cut& out) {
-  const Vec3 c_hat = (R - L) / chord;
+// Gaps up to 10 % of the chord are kept as they are; wider ones inside the chord,
+// up to max_bridged_gap, are bridged by the cubic that meets the curve on either
+// side with its slope there. Returns false, saying why, when the curve does not
+// span the chord.
+bool pickCut(std::vector<Cut>& cuts, const Frame& f, double max_bridged_gap, Cut& out, std::string& why) {
+  const Vec3& L = f.L;
+  const double chord = f.chord;
+  const Vec3& c_hat = f.c_hat;
   struct Sample {
     double x;
     Vec3 p;
@@ -112,17 +151,67 @@ bool pickCut(std::vector<Cut>& cuts, const Vec3& L, const Vec3& R, double chord,
       samples.push_back({x, p, cut.triangles[std::min(i, cut.triangles.size() - 1)]});
     }
   }
-  if (samples.size() < 3) return false;
+  if (samples.size() < 3) {
+    why = "does not cut the sail between luff and leech";
+    return false;
+  }
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.x < b.x; });
-  // The curve must span the chord without a large gap.
-  double gap = std::max(samples.front().x, chord - samples.back().x);
-  for (size_t i = 1; i < samples.size(); ++i) gap = std::max(gap, samples[i].x - samples[i - 1].x);
-  if (gap > 0.1 * chord) return false;
+  const double pct = 100.0 / chord;
+  if (samples.front().x > 0.1 * chord || chord - samples.back().x > 0.1 * chord) {
+    const bool luff = samples.front().x > 0.1 * chord;
+    why = "leaves " + formatFixed(pct * (luff ? samples.front().x : chord - samples.back().x), 0) +
+          " % of the chord at the " + (luff ? "luff" : "leech") + " uncovered (at most 10 %)";
+    return false;
+  }
+  std::vector<Eigen::Vector2d> xy;
+  std::vector<double> steps;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    xy.emplace_back(samples[i].x, (samples[i].p - L).dot(f.y_hat));
+    if (i > 0) steps.push_back(samples[i].x - samples[i - 1].x);
+  }
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  const double step = std::max(steps[steps.size() / 2], 1e-3 * chord);
   out.points.clear();
   out.triangles.clear();
-  for (const Sample& s : samples) {
-    out.points.push_back(s.p);
-    out.triangles.push_back(s.tri);
+  out.bridges.clear();
+  for (size_t i = 0; i < samples.size(); ++i) {
+    out.points.push_back(samples[i].p);
+    out.triangles.push_back(samples[i].tri);
+    if (i + 1 == samples.size()) break;
+    const double xa = samples[i].x, xb = samples[i + 1].x, gap = xb - xa;
+    if (gap <= 0.1 * chord) continue;
+    if (gap > max_bridged_gap * chord) {
+      why = "crosses a hole " + formatFixed(pct * gap, 0) + " % of the chord wide (bridged up to " +
+            formatFixed(100 * max_bridged_gap, 0) + " %)";
+      return false;
+    }
+    // Hermite cubic from (xa, ya) to (xb, yb) with the slopes the curve has there;
+    // its disagreement with one quadratic fitted to both sides is its uncertainty.
+    const double window = std::max(0.05 * chord, 0.5 * gap);
+    const double ya = xy[i].y(), yb = xy[i + 1].y();
+    const double sa = sideSlope(xy, xa, window, true), sb = sideSlope(xy, xb, window, false);
+    std::vector<Eigen::Vector2d> both;
+    for (const auto& v : xy)
+      if ((v.x() <= xa && v.x() >= xa - window) || (v.x() >= xb && v.x() <= xb + window)) both.push_back(v);
+    Eigen::MatrixXd A(both.size(), 3);
+    Eigen::VectorXd yv(both.size());
+    for (size_t k = 0; k < both.size(); ++k) {
+      const double u = (both[k].x() - xa) / gap;
+      A.row(static_cast<Eigen::Index>(k)) << 1, u, u * u;
+      yv[static_cast<Eigen::Index>(k)] = both[k].y();
+    }
+    const Eigen::Vector3d q = both.size() >= 3 ? Eigen::Vector3d(A.colPivHouseholderQr().solve(yv)) : Eigen::Vector3d::Zero();
+    Bridge bridge{xa, xb, 0};
+    const int n = std::max(2, static_cast<int>(std::ceil(gap / step)));
+    for (int k = 1; k < n; ++k) {
+      const double u = static_cast<double>(k) / n, u2 = u * u, u3 = u2 * u;
+      const double y = (2 * u3 - 3 * u2 + 1) * ya + (u3 - 2 * u2 + u) * gap * sa + (-2 * u3 + 3 * u2) * yb +
+                       (u3 - u2) * gap * sb;
+      if (both.size() >= 3) bridge.sd = std::max(bridge.sd, std::abs(y - (q[0] + u * (q[1] + u * q[2]))));
+      out.points.push_back(L + (xa + u * gap) * c_hat + y * f.y_hat);
+      out.triangles.push_back(samples[i].tri);
+    }
+    out.bridges.push_back(bridge);
   }
   return true;
 }
@@ -235,11 +324,6 @@ double correlationInflation(size_t n, double span, double correlation) {
   const double n_eff = std::max(3.0, span / correlation);
   return std::max(1.0, static_cast<double>(n) / n_eff);
 }
-
-struct Frame {
-  Vec3 L, R, c_hat, y_hat, m;  // luff, leech, chord direction, in-plane normal to chord, plane normal
-  double chord;
-};
 
 std::vector<Eigen::Vector2d> toChordCoords(const Cut& cut, const Frame& f) {
   std::vector<Eigen::Vector2d> xy;
@@ -362,9 +446,9 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
       f.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
       f.y_hat = f.m.cross(f.c_hat);
       auto cuts = cutMesh(mesh, f.L, f.m);
-      if (!pickCut(cuts, f.L, f.R, f.chord, cut))
-        throw AnalysisError("[cutSections] the section plane at fraction " + std::to_string(t) +
-                            " does not cut the sail between luff and leech (or leaves a gap over 10 % of the chord)");
+      std::string why;
+      if (!pickCut(cuts, f, p.max_bridged_gap, cut, why))
+        throw AnalysisError("[cutSections] the section plane at fraction " + formatFixed(t, 3) + " " + why);
     };
     cutAt(0);
     s.converged = true;
@@ -401,6 +485,15 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
     s.leech_point = f.R;
     const auto xy = toChordCoords(cut, f);
     s.curve_samples = xy.size();
+    auto bridged = [&](double x) {
+      for (const Bridge& b : cut.bridges)
+        if (x > b.x0 && x < b.x1) return true;
+      return false;
+    };
+    for (const Bridge& b : cut.bridges) s.bridged_pct += 100.0 * (b.x1 - b.x0) / f.chord;
+    if (!cut.bridges.empty())
+      result.warnings.push_back("section " + formatFixed(t, 3) + ": a hole in the scan, " +
+                                formatFixed(s.bridged_pct, 0) + " % of the chord, is bridged");
 
     // Maximum depth: refined by a cubic through the points around the deepest one.
     const size_t imax = maxDepthIndex(xy, f.chord);
@@ -419,6 +512,13 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
         depth_x = peak.x;
         sd_depth = peak.sd_depth * inflate;
         sd_x = peak.sd_x * inflate;
+        // A bridge under the crest's window carries its own uncertainty into the
+        // depth; a crest inside it could stand anywhere across it.
+        for (const Bridge& b : cut.bridges) {
+          if (b.x1 < depth_x - p.peak_window * f.chord || b.x0 > depth_x + p.peak_window * f.chord) continue;
+          sd_depth = std::hypot(sd_depth, b.sd);
+          if (depth_x > b.x0 && depth_x < b.x1) sd_x = std::hypot(sd_x, (b.x1 - b.x0) / std::sqrt(12.0));
+        }
       } else {
         result.warnings.push_back("section " + std::to_string(t) +
                                   ": no crest in the peak fit; the deepest cut point is used");
@@ -430,8 +530,8 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
     auto endAngle = [&](bool at_luff, double& sd_deg) {
       std::vector<Eigen::Vector2d> win;
       const double x_end = at_luff ? 0.0 : f.chord;
-      for (const auto& v : xy)
-        if (std::abs(v.x() - x_end) <= p.end_window * f.chord) win.emplace_back(v.x(), side * v.y());
+      for (const auto& v : xy)  // measured points only: a bridge is no evidence of the end's slope
+        if (std::abs(v.x() - x_end) <= p.end_window * f.chord && !bridged(v.x())) win.emplace_back(v.x(), side * v.y());
       const QuadFit q = fitQuadratic(win, x_end, 0.0);
       if (!q.ok) {
         sd_deg = std::numeric_limits<double>::quiet_NaN();

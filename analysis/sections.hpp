@@ -27,6 +27,12 @@ struct SectionParams {
   // independent points). Fit uncertainties count one independent sample per length.
   double noise_correlation_m = 0.0;
   int curve_points = 61;              // points of the output curve
+  // A hole in the scan (an occlusion by a sheet or spar, a dropout) breaks the
+  // section curve. Gaps up to 10 % of the chord are read as they are; inside
+  // the chord, wider ones up to this fraction are bridged by a cubic that keeps
+  // the slopes on either side, with a warning and the bridge's own uncertainty.
+  // The first and last 10 % of the chord (entry, exit) are never bridged.
+  double max_bridged_gap = 0.35;
 };
 
 // Per-section parameters; also used for their uncertainties (1σ, same units).
@@ -50,6 +56,7 @@ struct Section {
   bool converged = true;              // the normal search met its tolerance
   std::vector<Vec3> curve;            // boat frame, luff to leech
   size_t curve_samples = 0;           // cut points the parameters were computed from
+  double bridged_pct = 0;             // % of the chord bridged across holes (see max_bridged_gap)
 };
 
 struct SectionAnalysis {

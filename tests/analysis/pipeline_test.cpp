@@ -332,6 +332,48 @@ TEST(Pipeline, AFlatMainsailInItsSceneIsFound) {
   expectNoisyTargets(a, design);
 }
 
+// A scan with a hole: the samples within `radius` of the surface point at
+// section fraction f, chord fraction u removed (a sheet's shadow, a dropout).
+Cloud withHole(const Cloud& cloud, const SailSurface& surface, double f, double u, double radius) {
+  const Vec3 centre = surface.at(f, u);
+  Cloud out;
+  for (const Vec3& p : cloud.points)
+    if ((p - centre).norm() > radius) out.points.push_back(p);
+  return out;
+}
+
+TEST(Pipeline, AHoleOverTheCrestIsBridgedAndTheSectionStillMeetsTheTargets) {
+  // A hole 26 % of the mid section's chord wide, centred on its crest: the cut
+  // breaks in two and the section was refused (gaps over 10 % were an error),
+  // failing the whole analysis. The bridge keeps the slopes on either side.
+  const SailDesign design = exampleDesign(SailType::Main);
+  const SailSurface truth(design);
+  const double chord = truth.section(0.5).chord_m;
+  const double draft = truth.section(0.5).draft_pct / 100;
+  const Cloud holed = withHole(sampleSail(design, scan(40000)), truth, 0.5, draft, 0.13 * chord);
+  const SailAnalysis a = analyzeSail(holed);
+  ASSERT_EQ(a.sections.sections.size(), 3u);
+  const Section& mid = a.sections.sections[1];
+  EXPECT_NEAR(mid.bridged_pct, 26, 3);  // the ball meets the section plane in a 26 % chord
+  EXPECT_EQ(a.sections.sections[0].bridged_pct, 0);
+  EXPECT_EQ(a.sections.sections[2].bridged_pct, 0);
+  bool warned = false;
+  for (const std::string& w : a.sections.warnings) warned = warned || w.find("section 0.500: a hole") != std::string::npos;
+  EXPECT_TRUE(warned);
+  expectSectionsMatch(a, truth, kClean);
+  // The crest stands inside the bridge: its place is as uncertain as the bridge is wide.
+  EXPECT_GT(mid.uncertainty.draft_pct, 26 / std::sqrt(12.0) - 1);
+}
+
+TEST(Pipeline, AHoleWiderThanTheBridgeIsOneErrorNamingTheSection) {
+  const SailDesign design = exampleDesign(SailType::Main);
+  const SailSurface truth(design);
+  const double chord = truth.section(0.5).chord_m;
+  const Cloud holed = withHole(sampleSail(design, scan(40000)), truth, 0.5, 0.45, 0.22 * chord);
+  expectThrowWith<AnalysisError>([&] { analyzeSail(holed); },
+                                 {"[cutSections]", "fraction 0.500", "crosses a hole", "bridged up to 35 %"});
+}
+
 TEST(Pipeline, EmptyCloudIsRejected) {
   EXPECT_THROW(analyzeSail(Cloud{}), InvalidInput);
 }
