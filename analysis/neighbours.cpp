@@ -611,8 +611,9 @@ Eigen::Vector3i voxelOf(const Vec3& p, double size) {
 }
 
 int64_t voxelKey(const Eigen::Vector3i& c) {
-  return (static_cast<int64_t>(c.x()) * 73856093) ^ (static_cast<int64_t>(c.y()) * 19349663) ^
-         (static_cast<int64_t>(c.z()) * 83492791);
+  constexpr uint64_t kMask = (uint64_t{1} << 21) - 1;
+  auto bits = [](int v) { return static_cast<uint64_t>(static_cast<int64_t>(v)) & kMask; };
+  return static_cast<int64_t>((bits(c.x()) << 42) | (bits(c.y()) << 21) | bits(c.z()));
 }
 
 namespace {

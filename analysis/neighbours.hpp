@@ -115,7 +115,11 @@ double medianNeighbourDistance(const PointGrid& grid, const std::vector<Vec3>& p
 // the points, no sorting, several times cheaper for a yes-or-no on a large cloud.
 bool medianNeighbourDistanceBelow(const std::vector<Vec3>& points, double limit_m, size_t samples = 512);
 
-// Integer cell of a uniform grid of cubes `size` metres wide, and a hash of it.
+// Integer cell of a uniform grid of cubes `size` metres wide, and its key: the
+// three cell indices packed 21 bits each, so distinct cells within 2^20 cells of
+// the origin on every axis (20 km at 2 cm) have distinct keys. (A hash that mixed
+// them by XOR gave mirrored cells, (x, y, z) and (−x, −y, z), one key: around a
+// boat frame's origin at the mast foot, sail and mast samples shared voxels.)
 Eigen::Vector3i voxelOf(const Vec3& p, double size);
 int64_t voxelKey(const Eigen::Vector3i& cell);
 inline int64_t voxelKey(const Vec3& p, double size) { return voxelKey(voxelOf(p, size)); }

@@ -85,9 +85,18 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
   const double reach = 2 * sp.max_radius_m + 0.1;
   box.min() -= Vec3::Constant(reach);
   box.max() += Vec3::Constant(reach);
+  // Spars are among the unclustered points and the narrow or small clusters; a
+  // deck's or wall's thousands of points would only drown a boom's few hundred in
+  // the search's random samples.
+  std::vector<char> broad(cloud.size(), 0);
+  for (size_t c = 0; c < seg.clusters.size() && c < a.clusters.size(); ++c) {
+    const ClusterInfo::Shape shape = a.clusters[c].shape;
+    if (shape == ClusterInfo::Shape::Narrow || shape == ClusterInfo::Shape::TooSmall) continue;
+    for (uint32_t i : seg.clusters[c]) broad[i] = 1;
+  }
   std::vector<uint32_t> near;
   for (uint32_t i = 0; i < cloud.size(); ++i)
-    if (!in_sail[i] && box.contains(cloud.points[i])) near.push_back(i);
+    if (!in_sail[i] && !broad[i] && box.contains(cloud.points[i])) near.push_back(i);
   const SparSearch found = findSpars(cloud, normals, near, sp);
   a.spars = found.spars;
   if (found.spars.empty()) return sail;

@@ -237,15 +237,21 @@ SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const Sail
     info.rough_rms_m = spread.rough_rms_m;
     info.tilt_from_vertical_deg = std::asin(std::min(1.0, std::abs(info.plane_normal.z()))) * 180.0 / kPi;
     const double depth_needed = std::max(p.min_depth_m, p.min_depth_ratio * info.extent_m);
+    using Shape = ClusterInfo::Shape;
     if (info.extent_m < p.min_extent_m) {
+      info.shape = Shape::TooSmall;
       info.reason = "too small";
-    } else if (info.tilt_from_vertical_deg > p.max_tilt_deg) {
-      info.reason = "lies flat (deck, floor or ceiling)";
     } else if (info.width_m < p.min_width_ratio * info.extent_m) {
+      info.shape = Shape::Narrow;  // before "flat": a boom seen from above lies flat too
       info.reason = "narrow (spar or pole)";
+    } else if (info.tilt_from_vertical_deg > p.max_tilt_deg) {
+      info.shape = Shape::Flat;
+      info.reason = "lies flat (deck, floor or ceiling)";
     } else if (info.bend_rms_m < depth_needed) {
+      info.shape = Shape::Planar;
       info.reason = "planar (wall or panel)";
     } else {
+      info.shape = Shape::Curved;
       info.sail_like = true;
       info.reason = "curved surface";
     }

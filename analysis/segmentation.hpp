@@ -56,6 +56,10 @@ struct ClusterInfo {
   double bend_rms_m = 0;
   double rough_rms_m = 0;
   double tilt_from_vertical_deg = 0;  // 0 for a vertical surface, 90 for deck or floor
+  // What the picker made of it, in the order it asks: too small, narrow (a spar or
+  // pole), lying flat (deck, floor), planar (wall, panel), or curved (sail-like).
+  enum class Shape { TooSmall, Narrow, Flat, Planar, Curved };
+  Shape shape = Shape::TooSmall;
   bool sail_like = false;
   std::string reason;         // why it is or is not sail-like
 };

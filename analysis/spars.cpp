@@ -7,6 +7,7 @@
 #include <random>
 
 #include "analysis/errors.hpp"
+#include "analysis/neighbours.hpp"
 
 namespace sailshape {
 
@@ -233,22 +234,51 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
     // Score hypotheses on at most 20,000 of the points (every n-th); refine on all.
     const size_t stride = std::max<size_t>(1, pts.size() / 20000);
     std::uniform_int_distribution<size_t> pick(0, pool.size() - 1);
-    std::optional<Cylinder> best;
-    size_t best_score = 0;
+    // The second point of a pair comes from within a spar's diameter of the first
+    // (as NAPSAC samples): a boom's few hundred points beside a deck's tens of
+    // thousands still pair up on most draws that start on the boom.
+    const double reach = 2 * p.max_radius_m;
+    const PointGrid grid(pts, reach);
+    std::vector<uint32_t> around;
+    std::vector<double> around_d2;
+    auto scoreOf = [&](const Cylinder& c) {
+      size_t score = 0;
+      for (size_t k = 0; k < pts.size(); k += stride) score += std::abs(radialResidual(pts[k], c)) <= band;
+      return score;
+    };
+    // Two points' normals give a rough cylinder (a few mm of noise in a normal
+    // moves a thin spar's axis by centimetres): the best few hypotheses are each
+    // refined on their points, and the one the most points then fit wins.
+    constexpr size_t kRefined = 6;
+    std::vector<std::pair<size_t, Cylinder>> top;  // (score, hypothesis), best first
     for (int h = 0; h < p.hypotheses; ++h) {
-      const size_t i = pick(rng), j = pick(rng);
+      const size_t i = pick(rng);
+      grid.withinRadius(pts[i], reach, around, around_d2);
+      if (around.size() < 2) continue;
+      const size_t j = around[std::uniform_int_distribution<size_t>(0, around.size() - 1)(rng)];
       if (i == j) continue;
       const auto c = cylinderThrough(pts[i], normals[pool[i]], pts[j], normals[pool[j]], 4 * p.sensor_sigma_m);
       if (!c || c->radius < p.min_radius_m || c->radius > p.max_radius_m) continue;
-      size_t score = 0;
-      for (size_t k = 0; k < pts.size(); k += stride) score += std::abs(radialResidual(pts[k], *c)) <= band;
-      if (score > best_score) {
-        best_score = score;
-        best = c;
+      const size_t score = scoreOf(*c);
+      if (top.size() == kRefined && score <= top.back().first) continue;
+      top.emplace_back(score, *c);
+      std::stable_sort(top.begin(), top.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+      if (top.size() > kRefined) top.pop_back();
+    }
+    std::optional<Cylinder> refined;
+    size_t best_score = 0;
+    for (const auto& [score, hypothesis] : top) {
+      if (score * stride < p.min_support / 2) continue;
+      const Cylinder c = refineCylinder(pts, refineCylinder(pts, hypothesis, 3 * band), band);
+      if (!(c.radius >= p.min_radius_m && c.radius <= p.max_radius_m)) continue;
+      const size_t s2 = scoreOf(c);
+      if (s2 > best_score) {
+        best_score = s2;
+        refined = c;
       }
     }
-    if (!best || best_score * stride < p.min_support) break;
-    const Cylinder c = refineCylinder(pts, refineCylinder(pts, *best, 3 * band), band);
+    if (!refined || best_score * stride < p.min_support) break;
+    const Cylinder c = *refined;
     std::vector<double> along, angle;
     double sum2 = 0;
     for (const Vec3& x : pts) {

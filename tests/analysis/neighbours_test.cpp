@@ -452,6 +452,34 @@ TEST(MedianNeighbourDistanceBelow, AgreesWithTheMedianAtAndAroundIt) {
   EXPECT_FALSE(medianNeighbourDistanceBelow(g, -1.0));
 }
 
+TEST(VoxelKey, EveryCellAroundTheOriginHasItsOwnKey) {
+  // The boat frame's origin is the mast foot: sail, mast and boom all lie within a
+  // few hundred cells of it on either side. An XOR-mixing hash gave (12, −4, 231)
+  // and (−12, 4, 231) one key, so segmentation's voxel of mast samples joined a
+  // sail voxel across the mast. Every cell of a 61³ block around the origin, and
+  // cells at the packing's ±2^20 limits, keep distinct keys.
+  std::set<int64_t> keys;
+  size_t cells = 0;
+  for (int x = -30; x <= 30; ++x)
+    for (int y = -30; y <= 30; ++y)
+      for (int z = -30; z <= 30; ++z, ++cells) keys.insert(voxelKey(Eigen::Vector3i(x, y, z)));
+  EXPECT_EQ(keys.size(), cells);
+  EXPECT_NE(voxelKey(Eigen::Vector3i(12, -4, 231)), voxelKey(Eigen::Vector3i(-12, 4, 231)));
+  const int lim = 1 << 20;
+  std::set<std::tuple<int, int, int>> edge_cells;
+  std::set<int64_t> edge_keys;
+  for (int a : {-lim, -lim + 1, -1, 0, 1, lim - 1})
+    for (int b : {-lim, 0, lim - 1})
+      for (const Eigen::Vector3i& c : {Eigen::Vector3i(a, b, 0), Eigen::Vector3i(0, a, b), Eigen::Vector3i(b, 0, a)}) {
+        edge_cells.insert({c.x(), c.y(), c.z()});
+        edge_keys.insert(voxelKey(c));
+      }
+  EXPECT_EQ(edge_keys.size(), edge_cells.size());
+  // The key is the cell's: points in one cell share it, a point a cell away does not.
+  EXPECT_EQ(voxelKey(Vec3(0.011, -0.019, 4.62), 0.02), voxelKey(Vec3(0.019, -0.001, 4.6399), 0.02));
+  EXPECT_NE(voxelKey(Vec3(0.011, -0.019, 4.62), 0.02), voxelKey(Vec3(-0.011, 0.019, 4.62), 0.02));
+}
+
 TEST(KeyIds, NumbersKeysInTheOrderFirstSeenAndKeepsThemWhileGrowing) {
   // Starts small (16 slots) and grows many times over 10,000 keys, negative and
   // colliding-prone (multiples of a large power of two) among them.
