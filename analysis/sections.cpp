@@ -392,6 +392,8 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
     throw InvalidInput("[cutSections] plane must be normal, perpendicular or horizontal (got '" + p.plane + "')");
   if (!(p.end_window > 0 && p.end_window <= 0.5))
     throw InvalidInput("[cutSections] end_window must be in (0, 0.5] (got " + std::to_string(p.end_window) + ")");
+  if (!(p.max_bridged_gap >= 0 && p.max_bridged_gap < 1))
+    throw InvalidInput("[cutSections] max_bridged_gap must be in [0, 1) (got " + std::to_string(p.max_bridged_gap) + ")");
   if (!(p.peak_window > 0 && p.peak_window <= 0.5))
     throw InvalidInput("[cutSections] peak_window must be in (0, 0.5] (got " + std::to_string(p.peak_window) + ")");
   if (outline.luff.size() < 2 || outline.leech.size() < 2)

@@ -213,6 +213,8 @@ PlaneSpread splitPlaneSpread(const Cloud& cloud, const std::vector<uint32_t>& cl
 
 SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const SailPickParams& p) {
   if (seg.clusters.empty()) throw AnalysisError("[pickSailCluster] segmentation found no cluster to pick a sail from");
+  if (!(p.min_width_ratio >= 0 && p.min_width_ratio < 1))
+    throw InvalidInput("[pickSailCluster] min_width_ratio must be in [0, 1) (got " + std::to_string(p.min_width_ratio) + ")");
   SailPick pick;
   for (const auto& cluster : seg.clusters) {
     ClusterInfo info;

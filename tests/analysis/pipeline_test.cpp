@@ -365,6 +365,15 @@ TEST(Pipeline, AHoleOverTheCrestIsBridgedAndTheSectionStillMeetsTheTargets) {
   EXPECT_GT(mid.uncertainty.draft_pct, 26 / std::sqrt(12.0) - 1);
 }
 
+TEST(Pipeline, ABridgeOfAWholeChordIsRefused) {
+  AnalysisParams p;
+  for (double bad : {-0.1, 1.0}) {
+    p.sections.max_bridged_gap = bad;
+    expectThrowWith<InvalidInput>([&] { analyzeSail(sampleSail(exampleDesign(SailType::Main), scan(40000)), p); },
+                                  {"[cutSections]", "max_bridged_gap must be in [0, 1)"});
+  }
+}
+
 TEST(Pipeline, AHoleWiderThanTheBridgeIsOneErrorNamingTheSection) {
   const SailDesign design = exampleDesign(SailType::Main);
   const SailSurface truth(design);

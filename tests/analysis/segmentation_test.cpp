@@ -458,6 +458,11 @@ TEST(PickSailCluster, RejectsBadMethodsSeedsAndIndices) {
   p.seed_point = {1.0, 2.0};
   expectThrowWith<InvalidInput>([&] { pickSailCluster(s.cloud, s.seg, p); },
                                 {"[pickSailCluster]", "seed_point", "got 2 values"});
+  p.method = "auto";
+  p.min_width_ratio = -0.1;
+  expectThrowWith<InvalidInput>([&] { pickSailCluster(s.cloud, s.seg, p); },
+                                {"[pickSailCluster]", "min_width_ratio must be in [0, 1)"});
+  p.min_width_ratio = SailPickParams{}.min_width_ratio;
   p.method = "index";
   for (int i : {-1, 3}) {
     p.cluster_index = i;
