@@ -103,7 +103,9 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
                                      {"fair", sm.fair},
                                      {"bad", sm.bad},
                                      {"rms_displacement_m", sm.rms_displacement_m},
-                                     {"max_displacement_m", sm.max_displacement_m}}},
+                                     {"max_displacement_m", sm.max_displacement_m},
+                                     {"k_used", sm.k_used},
+                                     {"measured_noise_m", sm.measured_noise_m}}},
                       {"warnings", a.warnings}};
   return j;
 }

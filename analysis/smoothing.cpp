@@ -231,6 +231,45 @@ std::vector<uint32_t> pickAnchors(const std::vector<Vec3>& pts, double cell) {
   return best;
 }
 
+
+// Fewest neighbours a clean cloud brings k down to: a quadratic's six
+// coefficients from a few dozen points.
+constexpr size_t kMinAdaptedK = 40;
+
+// The cloud's noise: at up to `samples` points spread through it, the RMS distance
+// of its 24 nearest from the quadratic height field fitted to them over their
+// plane (scaled by √(24 / 18) for the fit's six coefficients); the median (m).
+double measuredNoise(const std::vector<Vec3>& pts, const PointGrid& grid, size_t samples = 256) {
+  constexpr size_t k0 = 24;
+  if (pts.size() < k0) return 0;
+  std::vector<uint32_t> idx;
+  std::vector<double> d2, rms;
+  const size_t stride = std::max<size_t>(1, pts.size() / samples);
+  for (size_t i = 0; i < pts.size(); i += stride) {
+    grid.nearest(pts[i], k0, idx, d2);
+    Vec3 mean = Vec3::Zero();
+    for (uint32_t j : idx) mean += pts[j];
+    mean /= static_cast<double>(idx.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (uint32_t j : idx) cov.noalias() += (pts[j] - mean) * (pts[j] - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    const Vec3 n = eig.eigenvectors().col(0), eu = eig.eigenvectors().col(2), ev = eig.eigenvectors().col(1);
+    const double scale = 1.0 / std::max(1e-9, std::sqrt(d2.back()));
+    Eigen::Matrix<double, Eigen::Dynamic, 6> a(idx.size(), 6);
+    Eigen::VectorXd h(idx.size());
+    for (size_t r = 0; r < idx.size(); ++r) {
+      const Vec3 d = pts[idx[r]] - mean;
+      const double u = scale * d.dot(eu), v = scale * d.dot(ev);
+      a.row(static_cast<Eigen::Index>(r)) << 1, u, v, u * u, u * v, v * v;
+      h[static_cast<Eigen::Index>(r)] = d.dot(n);
+    }
+    const Eigen::VectorXd residual = a * a.colPivHouseholderQr().solve(h) - h;
+    rms.push_back(std::sqrt(residual.squaredNorm() / static_cast<double>(idx.size() - 6)));
+  }
+  std::nth_element(rms.begin(), rms.begin() + rms.size() / 2, rms.end());
+  return rms[rms.size() / 2];
+}
+
 }  // namespace
 
 Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress& progress) {
@@ -266,6 +305,18 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
       k = std::min(pts.size(), static_cast<size_t>(std::lround(static_cast<double>(k) *
                                                                std::sqrt(density / p.reference_density_per_m2))));
       radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
+    }
+    if (p.adapt_to_noise) {
+      result.measured_noise_m = measuredNoise(pts, *median_grid);
+      const double ratio = result.measured_noise_m / (0.5 * p.good_m);
+      if (ratio < 1) {
+        const size_t fewer =
+            std::max<size_t>(kMinAdaptedK, std::lround(static_cast<double>(k) * std::sqrt(std::max(0.0, ratio))));
+        if (fewer < k) {
+          k = std::min(fewer, pts.size());
+          radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
+        }
+      }
     }
     result.k_used = k;
     // Gathered from a grid a little wider than the radius, so the k nearest of

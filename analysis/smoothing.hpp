@@ -21,6 +21,13 @@ struct SmoothingParams {
   // as √density / k: 4 mm noise at 200,000 points put exit angles 3° and drafts
   // 2 % off. There k grows with √density to hold it. 0: k stays fixed.
   double reference_density_per_m2 = 4000;
+  // Those neighbourhoods are sized for the sensor's noise (good_m). A cloud whose
+  // measured noise (the RMS off quadratics through 24 neighbours) is under half of
+  // that needs less averaging and takes a smaller one: k shrinks with √(noise /
+  // (good_m / 2)), down to 40. The quadratic's bias grows with the radius, and on a
+  // clean 1:5 model mainsail k = 400 spanned half its 18 cm top chord (exit 2.3°,
+  // twist 0.5° off). false: k as above whatever the noise.
+  bool adapt_to_noise = true;
   int polynomial_order = 2;     // 1: plane, 2: quadratic
   // 0: a local surface fitted at every point (MLS proper). > 0: inside the
   // surface, quadratics fitted at anchors about anchor_ratio × the
@@ -43,6 +50,7 @@ struct Smoothing {
   double max_displacement_m = 0;
   double mean_radius_m = 0;           // mean neighbourhood radius used
   size_t k_used = 0;                  // neighbours per fit: k_neighbours, more in a dense cloud
+  double measured_noise_m = 0;        // the cloud's noise as measured (see adapt_to_noise)
   size_t fitted_surfaces = 0;         // local surfaces fitted (every point's without anchors)
   std::vector<std::string> warnings;
 };

@@ -275,6 +275,25 @@ TEST(SmoothMls, TakesMoreNeighboursInADenseCloud) {
   EXPECT_EQ(smoothMls(noisyPlane(8000, kSigma, 4), p).k_used, static_cast<size_t>(p.k_neighbours));
 }
 
+TEST(SmoothMls, MeasuresTheNoiseAndTakesFewerNeighboursOnACleanCloud) {
+  // Off quadratics through 24 neighbours a plane with σ noise leaves σ (the fit's six
+  // coefficients are counted); a clean one leaves nothing, and then k falls to 40:
+  // there is no noise to average and a wide neighbourhood only adds the bias.
+  const SmoothingParams p;
+  const Smoothing noisy = smoothMls(noisyPlane(8000, kSigma, 5), p);
+  EXPECT_NEAR(noisy.measured_noise_m, kSigma, 0.1 * kSigma);  // 256 samples of 18 degrees of freedom: ±4 %
+  EXPECT_EQ(noisy.k_used, static_cast<size_t>(p.k_neighbours));
+  const Smoothing clean = smoothMls(noisyPlane(8000, 0.0, 5), p);
+  EXPECT_LT(clean.measured_noise_m, 1e-6);
+  EXPECT_EQ(clean.k_used, 40u);
+  // Half the sensor's σ is where it starts: k shrinks with √(noise / (σ/2)).
+  const Smoothing quarter = smoothMls(noisyPlane(8000, kSigma / 4, 5), p);
+  EXPECT_NEAR(static_cast<double>(quarter.k_used), p.k_neighbours * std::sqrt(0.5), 0.06 * p.k_neighbours);
+  SmoothingParams fixed = p;
+  fixed.adapt_to_noise = false;
+  EXPECT_EQ(smoothMls(noisyPlane(8000, 0.0, 5), fixed).k_used, static_cast<size_t>(p.k_neighbours));
+}
+
 TEST(SmoothMls, RejectsBadParametersAndSmallClouds) {
   const Cloud in = noisyPlane(100, kSigma, 7);
   auto with = [](auto change) {
