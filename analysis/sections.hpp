@@ -31,7 +31,8 @@ struct SectionParams {
   // section curve. Gaps up to 10 % of the chord are read as they are; inside
   // the chord, wider ones up to this fraction are bridged by a cubic that keeps
   // the slopes on either side, with a warning and the bridge's own uncertainty.
-  // The first and last 10 % of the chord (entry, exit) are never bridged.
+  // A curve that leaves over 10 % uncovered at an end is refused, and the entry
+  // and exit fits read measured points only, never a bridge's.
   double max_bridged_gap = 0.35;
 };
 

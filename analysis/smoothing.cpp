@@ -231,7 +231,6 @@ std::vector<uint32_t> pickAnchors(const std::vector<Vec3>& pts, double cell) {
   return best;
 }
 
-
 // Fewest neighbours a clean cloud brings k down to: a quadratic's six
 // coefficients from a few dozen points.
 constexpr size_t kMinAdaptedK = 40;
