@@ -7,6 +7,7 @@
 
 #include "acquisition/unit_config.hpp"
 #include "analysis/errors.hpp"
+#include "analysis/principal_axes.hpp"
 
 namespace sailshape {
 
@@ -34,18 +35,14 @@ std::vector<Vec3> pointsOf(const CalibrationTarget& t, double p, double theta) {
 
 // Initial shape by principal axes: plane normal = least variance; cylinder axis = most variance.
 Shape initialShape(const CalibrationTarget& t, const std::vector<Vec3>& pts) {
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& q : pts) mean += q;
-  mean /= static_cast<double>(pts.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Vec3& q : pts) cov += (q - mean) * (q - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  const PrincipalAxes pa = principalAxes(pts);
+  const Vec3& mean = pa.mean;
   Shape s;
   if (t.kind == CalibrationTarget::Kind::Plane) {
-    s.n = es.eigenvectors().col(0);
+    s.n = pa.axes.col(0);
     s.d = s.n.dot(mean);
   } else {
-    s.n = es.eigenvectors().col(2);
+    s.n = pa.axes.col(2);
     // The scanner sees the near side: the axis lies one radius behind the centroid, away from the origin.
     Vec3 away = mean - s.n * s.n.dot(mean);
     if (away.norm() < 1e-9) away = s.n.unitOrthogonal();

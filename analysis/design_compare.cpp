@@ -1,6 +1,5 @@
 #include "analysis/design_compare.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <Eigen/Geometry>
 #include <cmath>
@@ -11,23 +10,13 @@
 #include <utility>
 
 #include "analysis/errors.hpp"
+#include "analysis/principal_axes.hpp"
 #include "analysis/surface.hpp"
 
 namespace sailshape {
 namespace {
 
 constexpr uint32_t kLeafTriangles = 4;  // 2 and 8 measured no faster
-
-// Unit normal of the least-squares plane through `points`, and their mean.
-std::pair<Vec3, Vec3> fitPlane(const std::vector<Vec3>& points) {
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& p : points) mean += p;
-  mean /= static_cast<double>(points.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Vec3& p : points) cov += (p - mean) * (p - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-  return {es.eigenvectors().col(0).normalized(), mean};
-}
 
 double percentile(const std::vector<double>& sorted, double q) {
   const double x = q * static_cast<double>(sorted.size() - 1);
@@ -164,7 +153,9 @@ DesignDistance::DesignDistance(const Mesh& design) {
     warnings_.push_back("the design mesh has no boundary: leeward taken from the plane fitted to all its vertices");
     rim = design.vertices;
   }
-  auto [n, origin] = fitPlane(rim);
+  const PrincipalAxes rim_plane = principalAxes(rim);
+  Vec3 n = rim_plane.axes.col(0);
+  const Vec3 origin = rim_plane.mean;
   double offset = 0;
   for (size_t t = 0; t < nt; ++t) offset += area[t] * (centroid_[t] - origin).dot(n);
   offset /= total_area;

@@ -1,6 +1,5 @@
 #include "analysis/plane_detection.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -10,6 +9,7 @@
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
 #include "analysis/normals.hpp"
+#include "analysis/principal_axes.hpp"
 
 namespace sailshape {
 namespace {
@@ -166,24 +166,15 @@ std::vector<std::vector<uint32_t>> connectedParts(const std::vector<uint32_t>& p
 DetectedPlane fitPlane(const std::vector<Vec3>& points, const std::vector<uint32_t>& indices) {
   if (indices.size() < 3)
     throw InvalidInput("[fitPlane] needs at least 3 points (got " + std::to_string(indices.size()) + ")");
-  Vec3 c = Vec3::Zero();
-  for (uint32_t i : indices) c += points[i];
-  c /= static_cast<double>(indices.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (uint32_t i : indices) {
-    const Vec3 d = points[i] - c;
-    cov += d * d.transpose();
-  }
-  cov /= static_cast<double>(indices.size());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  const PrincipalAxes pa = principalAxes(points, indices);
   DetectedPlane plane;
-  plane.normal = es.eigenvectors().col(0).normalized();
-  plane.centroid = c;
-  plane.offset_m = plane.normal.dot(c);
+  plane.normal = pa.axes.col(0);
+  plane.centroid = pa.mean;
+  plane.offset_m = plane.normal.dot(pa.mean);
   plane.points = indices.size();
-  plane.rms_m = std::sqrt(std::max(es.eigenvalues()(0), 0.0));
-  plane.extent_m = 4 * std::sqrt(std::max(es.eigenvalues()(2), 0.0));
-  plane.width_m = 4 * std::sqrt(std::max(es.eigenvalues()(1), 0.0));
+  plane.rms_m = std::sqrt(pa.variance[0]);
+  plane.extent_m = 4 * std::sqrt(pa.variance[2]);
+  plane.width_m = 4 * std::sqrt(pa.variance[1]);
   plane.indices = indices;
   return plane;
 }

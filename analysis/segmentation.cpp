@@ -1,12 +1,12 @@
 #include "analysis/segmentation.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <deque>
 #include <limits>
 
 #include "analysis/errors.hpp"
+#include "analysis/principal_axes.hpp"
 
 namespace sailshape {
 namespace {
@@ -178,39 +178,6 @@ std::vector<uint32_t> addClusterFringe(const Segmentation& seg, size_t cluster, 
   return members;
 }
 
-namespace {
-
-// A cluster's spread off its best-fit plane, split into what a quadratic height
-// field over the plane takes away (the bend) and what stays (the roughness):
-// bend² + roughness² = the plane's mean square. `axes` are the cluster's principal
-// directions (covariance eigenvectors, smallest first); `extent_m` scales the plane
-// coordinates to about ±1 for a well-conditioned fit.
-struct PlaneSpread {
-  double bend_rms_m = 0, rough_rms_m = 0;
-};
-
-PlaneSpread splitPlaneSpread(const Cloud& cloud, const std::vector<uint32_t>& cluster, const Vec3& mean,
-                             const Eigen::Matrix3d& axes, double extent_m) {
-  const double s = 1.0 / std::max(1e-9, extent_m);
-  Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
-  double hh = 0;
-  for (uint32_t i : cluster) {
-    const Vec3 d = cloud.points[i] - mean;
-    const double u = s * d.dot(axes.col(2)), v = s * d.dot(axes.col(1)), h = d.dot(axes.col(0));
-    Eigen::Matrix<double, 6, 1> row;
-    row << 1, u, v, u * u, u * v, v * v;
-    ata.noalias() += row * row.transpose();
-    atb += h * row;
-    hh += h * h;
-  }
-  const double n = static_cast<double>(cluster.size());
-  const double left = std::max(0.0, hh - ata.ldlt().solve(atb).dot(atb)) / n;
-  return {std::sqrt(std::max(0.0, hh / n - left)), std::sqrt(left)};
-}
-
-}  // namespace
-
 SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const SailPickParams& p) {
   if (seg.clusters.empty()) throw AnalysisError("[pickSailCluster] segmentation found no cluster to pick a sail from");
   if (!(p.min_width_ratio >= 0 && p.min_width_ratio < 1))
@@ -219,24 +186,18 @@ SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const Sail
   for (const auto& cluster : seg.clusters) {
     ClusterInfo info;
     info.points = cluster.size();
-    Vec3 mean = Vec3::Zero();
-    for (uint32_t i : cluster) mean += cloud.points[i];
-    mean /= static_cast<double>(cluster.size());
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (uint32_t i : cluster) {
-      const Vec3 d = cloud.points[i] - mean;
-      cov.noalias() += d * d.transpose();
-    }
-    cov /= static_cast<double>(cluster.size());
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    info.centroid = mean;
-    info.plane_normal = eig.eigenvectors().col(0);
-    info.plane_rms_m = std::sqrt(std::max(0.0, eig.eigenvalues()[0]));
-    info.extent_m = 4.0 * std::sqrt(std::max(0.0, eig.eigenvalues()[2]));
-    info.width_m = 4.0 * std::sqrt(std::max(0.0, eig.eigenvalues()[1]));
-    const PlaneSpread spread = splitPlaneSpread(cloud, cluster, mean, eig.eigenvectors(), info.extent_m);
-    info.bend_rms_m = spread.bend_rms_m;
-    info.rough_rms_m = spread.rough_rms_m;
+    const PrincipalAxes pa = principalAxes(cloud.points, cluster);
+    info.centroid = pa.mean;
+    info.plane_normal = pa.axes.col(0);
+    info.plane_rms_m = std::sqrt(pa.variance[0]);
+    info.extent_m = 4.0 * std::sqrt(pa.variance[2]);
+    info.width_m = 4.0 * std::sqrt(pa.variance[1]);
+    // The spread off the plane, split into what a quadratic height field takes up (the
+    // bend of a sail or a bowed panel) and what stays (noise and roughness).
+    const HeightFieldSpread spread = quadraticHeightFieldSpread(cloud.points, cluster, pa);
+    const double n = static_cast<double>(spread.points);
+    info.bend_rms_m = std::sqrt((spread.plane_ss_m2 - spread.residual_ss_m2) / n);
+    info.rough_rms_m = std::sqrt(spread.residual_ss_m2 / n);
     info.tilt_from_vertical_deg = std::asin(std::min(1.0, std::abs(info.plane_normal.z()))) * 180.0 / kPi;
     const double depth_needed = std::max(p.min_depth_m, p.min_depth_ratio * info.extent_m);
     using Shape = ClusterInfo::Shape;

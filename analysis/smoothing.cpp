@@ -10,6 +10,7 @@
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
+#include "analysis/principal_axes.hpp"
 
 namespace sailshape {
 namespace {
@@ -246,24 +247,8 @@ double measuredNoise(const std::vector<Vec3>& pts, const PointGrid& grid, size_t
   const size_t stride = std::max<size_t>(1, pts.size() / samples);
   for (size_t i = 0; i < pts.size(); i += stride) {
     grid.nearest(pts[i], k0, idx, d2);
-    Vec3 mean = Vec3::Zero();
-    for (uint32_t j : idx) mean += pts[j];
-    mean /= static_cast<double>(idx.size());
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (uint32_t j : idx) cov.noalias() += (pts[j] - mean) * (pts[j] - mean).transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    const Vec3 n = eig.eigenvectors().col(0), eu = eig.eigenvectors().col(2), ev = eig.eigenvectors().col(1);
-    const double scale = 1.0 / std::max(1e-9, std::sqrt(d2.back()));
-    Eigen::Matrix<double, Eigen::Dynamic, 6> a(idx.size(), 6);
-    Eigen::VectorXd h(idx.size());
-    for (size_t r = 0; r < idx.size(); ++r) {
-      const Vec3 d = pts[idx[r]] - mean;
-      const double u = scale * d.dot(eu), v = scale * d.dot(ev);
-      a.row(static_cast<Eigen::Index>(r)) << 1, u, v, u * u, u * v, v * v;
-      h[static_cast<Eigen::Index>(r)] = d.dot(n);
-    }
-    const Eigen::VectorXd residual = a * a.colPivHouseholderQr().solve(h) - h;
-    rms.push_back(std::sqrt(residual.squaredNorm() / static_cast<double>(idx.size() - 6)));
+    const HeightFieldSpread f = quadraticHeightFieldSpread(pts, idx, principalAxes(pts, idx));
+    rms.push_back(std::sqrt(f.residual_ss_m2 / static_cast<double>(f.points - 6)));
   }
   std::nth_element(rms.begin(), rms.begin() + rms.size() / 2, rms.end());
   return rms[rms.size() / 2];

@@ -5,12 +5,12 @@
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <limits>
 #include <numeric>
 
 #include "analysis/errors.hpp"
+#include "analysis/principal_axes.hpp"
 
 namespace sailshape {
 namespace {
@@ -24,17 +24,12 @@ using Delaunay = CGAL::Delaunay_triangulation_2<Kernel, Tds>;
 constexpr uint32_t kNoTriangle = std::numeric_limits<uint32_t>::max();
 
 std::vector<std::pair<Kernel::Point_2, uint32_t>> projectToPlane(const Cloud& cloud) {
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& p : cloud.points) mean += p;
-  mean /= static_cast<double>(cloud.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Vec3& p : cloud.points) cov.noalias() += (p - mean) * (p - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  const Vec3 a = eig.eigenvectors().col(2), b = eig.eigenvectors().col(1);
+  const PrincipalAxes pa = principalAxes(cloud.points);
+  const Vec3 a = pa.axes.col(2), b = pa.axes.col(1);
   std::vector<std::pair<Kernel::Point_2, uint32_t>> pts;
   pts.reserve(cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) {
-    const Vec3 d = cloud.points[i] - mean;
+    const Vec3 d = cloud.points[i] - pa.mean;
     pts.emplace_back(Kernel::Point_2(d.dot(a), d.dot(b)), static_cast<uint32_t>(i));
   }
   return pts;
