@@ -98,25 +98,58 @@ std::vector<Cut> cutMesh(const Mesh& mesh, const Vec3& q, const Vec3& m) {
   return cuts;
 }
 
-// Slope at x_end of a least-squares line (2 points) or quadratic (more) through
-// the chord-coordinate points within `window` of x_end on one side.
+// Least-squares polynomial of `degree` through xy, in u = (x - x0) / scale;
+// coefficients by rising power.
+Eigen::VectorXd fitPolynomial(const std::vector<Eigen::Vector2d>& xy, double x0, double scale, int degree) {
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(xy.size()), degree + 1);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(xy.size()));
+  for (size_t i = 0; i < xy.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    const double u = (xy[i].x() - x0) / scale;
+    double power = 1;
+    for (int k = 0; k <= degree; ++k, power *= u) A(r, k) = power;
+    y[r] = xy[i].y();
+  }
+  return A.colPivHouseholderQr().solve(y);
+}
+
+// Slope at x_end of a least-squares line (2 or 3 points) or quadratic (more)
+// through the chord-coordinate points within `window` of x_end on one side.
 double sideSlope(const std::vector<Eigen::Vector2d>& xy, double x_end, double window, bool left) {
   std::vector<Eigen::Vector2d> win;
   for (const auto& v : xy)
     if (left ? (v.x() <= x_end && v.x() >= x_end - window) : (v.x() >= x_end && v.x() <= x_end + window))
       win.push_back(v);
   if (win.size() < 2) return 0;
-  const int cols = win.size() >= 4 ? 3 : 2;
-  Eigen::MatrixXd A(win.size(), cols);
-  Eigen::VectorXd y(win.size());
-  for (size_t i = 0; i < win.size(); ++i) {
-    const double u = win[i].x() - x_end;
-    A(static_cast<Eigen::Index>(i), 0) = 1;
-    A(static_cast<Eigen::Index>(i), 1) = u;
-    if (cols == 3) A(static_cast<Eigen::Index>(i), 2) = u * u;
-    y[static_cast<Eigen::Index>(i)] = win[i].y();
+  return fitPolynomial(win, x_end, 1.0, win.size() >= 4 ? 2 : 1)[1];
+}
+
+// The curve across the gap between the chord-coordinate samples xy[i] and
+// xy[i + 1] (sorted by x): the Hermite cubic that meets the curve on either side
+// with its slope there. Its points inside the gap, evenly spaced about `step`
+// apart, are appended to `inside`; its uncertainty (the returned bridge's sd) is
+// its largest disagreement with one quadratic fitted to both sides.
+Bridge bridgeGap(const std::vector<Eigen::Vector2d>& xy, size_t i, double chord, double step,
+                 std::vector<Eigen::Vector2d>& inside) {
+  const double xa = xy[i].x(), xb = xy[i + 1].x(), gap = xb - xa;
+  const double ya = xy[i].y(), yb = xy[i + 1].y();
+  const double window = std::max(0.05 * chord, 0.5 * gap);
+  const double sa = sideSlope(xy, xa, window, true), sb = sideSlope(xy, xb, window, false);
+  std::vector<Eigen::Vector2d> both;
+  for (const auto& v : xy)
+    if ((v.x() <= xa && v.x() >= xa - window) || (v.x() >= xb && v.x() <= xb + window)) both.push_back(v);
+  const bool checked = both.size() >= 3;
+  const Eigen::VectorXd q = checked ? fitPolynomial(both, xa, gap, 2) : Eigen::VectorXd::Zero(3);
+  Bridge bridge{xa, xb, 0};
+  const int n = std::max(2, static_cast<int>(std::ceil(gap / step)));
+  for (int k = 1; k < n; ++k) {
+    const double u = static_cast<double>(k) / n, u2 = u * u, u3 = u2 * u;
+    const double y = (2 * u3 - 3 * u2 + 1) * ya + (u3 - 2 * u2 + u) * gap * sa + (-2 * u3 + 3 * u2) * yb +
+                     (u3 - u2) * gap * sb;
+    if (checked) bridge.sd = std::max(bridge.sd, std::abs(y - (q[0] + u * (q[1] + u * q[2]))));
+    inside.emplace_back(xa + u * gap, y);
   }
-  return A.colPivHouseholderQr().solve(y)[1];
+  return bridge;
 }
 
 // The section curve from luff to leech: the cut pieces that lie over the chord
@@ -185,30 +218,10 @@ bool pickCut(std::vector<Cut>& cuts, const Frame& f, double max_bridged_gap, Cut
             formatFixed(100 * max_bridged_gap, 0) + " %)";
       return false;
     }
-    // Hermite cubic from (xa, ya) to (xb, yb) with the slopes the curve has there;
-    // its disagreement with one quadratic fitted to both sides is its uncertainty.
-    const double window = std::max(0.05 * chord, 0.5 * gap);
-    const double ya = xy[i].y(), yb = xy[i + 1].y();
-    const double sa = sideSlope(xy, xa, window, true), sb = sideSlope(xy, xb, window, false);
-    std::vector<Eigen::Vector2d> both;
-    for (const auto& v : xy)
-      if ((v.x() <= xa && v.x() >= xa - window) || (v.x() >= xb && v.x() <= xb + window)) both.push_back(v);
-    Eigen::MatrixXd A(both.size(), 3);
-    Eigen::VectorXd yv(both.size());
-    for (size_t k = 0; k < both.size(); ++k) {
-      const double u = (both[k].x() - xa) / gap;
-      A.row(static_cast<Eigen::Index>(k)) << 1, u, u * u;
-      yv[static_cast<Eigen::Index>(k)] = both[k].y();
-    }
-    const Eigen::Vector3d q = both.size() >= 3 ? Eigen::Vector3d(A.colPivHouseholderQr().solve(yv)) : Eigen::Vector3d::Zero();
-    Bridge bridge{xa, xb, 0};
-    const int n = std::max(2, static_cast<int>(std::ceil(gap / step)));
-    for (int k = 1; k < n; ++k) {
-      const double u = static_cast<double>(k) / n, u2 = u * u, u3 = u2 * u;
-      const double y = (2 * u3 - 3 * u2 + 1) * ya + (u3 - 2 * u2 + u) * gap * sa + (-2 * u3 + 3 * u2) * yb +
-                       (u3 - u2) * gap * sb;
-      if (both.size() >= 3) bridge.sd = std::max(bridge.sd, std::abs(y - (q[0] + u * (q[1] + u * q[2]))));
-      out.points.push_back(L + (xa + u * gap) * c_hat + y * f.y_hat);
+    std::vector<Eigen::Vector2d> inside;
+    const Bridge bridge = bridgeGap(xy, i, chord, step, inside);
+    for (const Eigen::Vector2d& v : inside) {
+      out.points.push_back(L + v.x() * c_hat + v.y() * f.y_hat);
       out.triangles.push_back(samples[i].tri);
     }
     out.bridges.push_back(bridge);
