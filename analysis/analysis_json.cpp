@@ -56,6 +56,10 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
   nlohmann::json sections = nlohmann::json::array();
   for (const Section& s : a.sections.sections) sections.push_back(sectionToJson(s));
   j["sections"] = std::move(sections);
+  nlohmann::json unmeasured = nlohmann::json::array();
+  for (const UnmeasuredSection& u : a.sections.unmeasured)
+    unmeasured.push_back({{"fraction", u.fraction}, {"reason", u.reason}});
+  j["unmeasured_sections"] = std::move(unmeasured);
   const LuffCurve& l = a.luff;
   j["luff"] = {{"luff_chord_m", l.luff_chord_m},
                {"lufa_sag_m", l.lufa_sag_m},

@@ -331,25 +331,40 @@ MeshSections analyzeMeshSections(const Mesh& mesh, const OutlineParams& outline,
 }
 
 std::vector<SectionDelta> sectionDeltas(const SectionAnalysis& design, const SectionAnalysis& flying) {
-  auto fractions = [](const SectionAnalysis& a) {
+  // The fractions each analysis was asked for, measured or not.
+  auto asked = [](const SectionAnalysis& a) {
+    std::vector<double> f;
+    for (const Section& x : a.sections) f.push_back(x.fraction);
+    for (const UnmeasuredSection& x : a.unmeasured) f.push_back(x.fraction);
+    std::sort(f.begin(), f.end());
+    return f;
+  };
+  auto list = [](const std::vector<double>& f) {
     std::string s;
-    for (const Section& x : a.sections) s += (s.empty() ? "" : ", ") + std::to_string(x.fraction);
+    for (double x : f) s += (s.empty() ? "" : ", ") + std::to_string(x);
     return "[" + s + "]";
   };
-  bool same = design.sections.size() == flying.sections.size();
-  for (size_t i = 0; same && i < design.sections.size(); ++i)
-    same = std::abs(design.sections[i].fraction - flying.sections[i].fraction) < 1e-9;
-  if (!same)
-    throw InvalidInput("[sectionDeltas] design sections at " + fractions(design) + " but flying sections at " +
-                       fractions(flying));
+  const std::vector<double> fd = asked(design), ff = asked(flying);
+  bool same = fd.size() == ff.size();
+  for (size_t i = 0; same && i < fd.size(); ++i) same = std::abs(fd[i] - ff[i]) < 1e-9;
+  if (!same) throw InvalidInput("[sectionDeltas] design sections at " + list(fd) + " but flying sections at " + list(ff));
+  // Sections measured on both; one left unmeasured on either side has no delta.
   std::vector<SectionDelta> out;
-  for (size_t i = 0; i < design.sections.size(); ++i) {
-    SectionDelta d;
-    d.fraction = design.sections[i].fraction;
-    d.design = design.sections[i].value;
-    d.flying = flying.sections[i].value;
+  for (const Section& ds : design.sections)
+    for (const Section& fs : flying.sections)
+      if (std::abs(ds.fraction - fs.fraction) < 1e-9) {
+        SectionDelta d;
+        d.fraction = ds.fraction;
+        d.design = ds.value;
+        d.flying = fs.value;
+        out.push_back(d);
+      }
+  // twist_rel on both sides from the lowest section they share, whichever each
+  // analysis measured lowest.
+  for (SectionDelta& d : out) {
+    d.design.twist_rel_deg = d.design.twist_deg - out.front().design.twist_deg;
+    d.flying.twist_rel_deg = d.flying.twist_deg - out.front().flying.twist_deg;
     d.delta = minus(d.flying, d.design);
-    out.push_back(d);
   }
   return out;
 }

@@ -114,8 +114,10 @@ struct SectionDelta {
   SectionParameters delta;  // flying − design, field by field
 };
 
-// Pairs the sections at the same fractions. Throws InvalidInput when the two
-// analyses were not cut at the same fractions.
+// Pairs the sections at the same fractions; a section unmeasured in either
+// analysis has no delta, and twist_rel is taken from the lowest section both
+// measured. Throws InvalidInput when the two analyses were not asked for the same
+// fractions.
 std::vector<SectionDelta> sectionDeltas(const SectionAnalysis& design, const SectionAnalysis& flying);
 
 struct DesignComparison {

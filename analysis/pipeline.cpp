@@ -142,6 +142,11 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
       throw InvalidInput("[analyzeSail] point " + std::to_string(i) + " has a non-finite coordinate");
   if (!(p.sensor_sigma_m > 0))
     throw InvalidInput("[analyzeSail] sensor_sigma_m must be > 0 (got " + std::to_string(p.sensor_sigma_m) + ")");
+  {  // the sections come last: a bad parameter of theirs is reported before the work, not after
+    SectionParams sp = p.sections;
+    sp.sensor_sigma_m = p.sensor_sigma_m;
+    checkSectionParams(sp);
+  }
   SailAnalysis a;
   a.points_in = input.size();
   Cloud cloud = input;

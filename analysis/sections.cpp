@@ -399,8 +399,7 @@ std::vector<double> sectionFractions(const SectionParams& p) {
   return f;
 }
 
-SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const SectionParams& p) {
-  if (mesh.empty()) throw InvalidInput("[cutSections] empty mesh");
+void checkSectionParams(const SectionParams& p) {
   if (p.plane != "normal" && p.plane != "perpendicular" && p.plane != "horizontal")
     throw InvalidInput("[cutSections] plane must be normal, perpendicular or horizontal (got '" + p.plane + "')");
   if (!(p.end_window > 0 && p.end_window <= 0.5))
@@ -409,6 +408,22 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
     throw InvalidInput("[cutSections] max_bridged_gap must be in [0, 1) (got " + std::to_string(p.max_bridged_gap) + ")");
   if (!(p.peak_window > 0 && p.peak_window <= 0.5))
     throw InvalidInput("[cutSections] peak_window must be in (0, 0.5] (got " + std::to_string(p.peak_window) + ")");
+  auto need = [](bool ok, const std::string& what, double got) {
+    if (!ok) throw InvalidInput("[cutSections] " + what + " (got " + formatFixed(got, 6) + ")");
+  };
+  need(p.normal_tolerance_deg > 0, "normal_tolerance_deg must be > 0", p.normal_tolerance_deg);
+  need(p.max_tilt_deg > 0 && p.max_tilt_deg < 90, "max_tilt_deg must be in (0, 90)", p.max_tilt_deg);
+  need(p.max_iterations >= 0, "max_iterations must be >= 0", p.max_iterations);
+  need(p.normal_radius > 0 && p.normal_radius <= 0.5, "normal_radius must be in (0, 0.5]", p.normal_radius);
+  need(p.sensor_sigma_m >= 0, "sensor_sigma_m must be >= 0 (0: an exact surface)", p.sensor_sigma_m);
+  need(p.noise_correlation_m >= 0, "noise_correlation_m must be >= 0", p.noise_correlation_m);
+  need(p.curve_points >= 2, "curve_points must be >= 2", p.curve_points);
+  sectionFractions(p);
+}
+
+SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const SectionParams& p) {
+  checkSectionParams(p);
+  if (mesh.empty()) throw InvalidInput("[cutSections] empty mesh");
   if (outline.luff.size() < 2 || outline.leech.size() < 2)
     throw InvalidInput("[cutSections] outline has no luff or leech");
   const std::vector<double> fractions = sectionFractions(p);
@@ -427,163 +442,181 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
   const double sigma_ends = std::hypot(sigma_luff, sigma_leech);  // of the chord vector, per axis
   SectionAnalysis result;
   for (double t : fractions) {
-    Section s;
-    s.fraction = t;
-    Frame f;
-    f.L = pointAtFraction(outline.luff, t);
-    if (p.plane == "horizontal") {
-      // The leech point is where the leech crosses the luff point's height.
-      bool found = false;
-      for (size_t i = 1; i < outline.leech.size() && !found; ++i) {
-        const Vec3 &a = outline.leech[i - 1], &b = outline.leech[i];
-        if ((a.z() - f.L.z()) * (b.z() - f.L.z()) <= 0 && a.z() != b.z()) {
-          f.R = a + (f.L.z() - a.z()) / (b.z() - a.z()) * (b - a);
-          found = true;
+    // A section whose plane finds no curve across the chord is left unmeasured;
+    // the others stand.
+    try {
+      Section s;
+      s.fraction = t;
+      Frame f;
+      f.L = pointAtFraction(outline.luff, t);
+      if (p.plane == "horizontal") {
+        // The leech point is where the leech crosses the luff point's height.
+        bool found = false;
+        for (size_t i = 1; i < outline.leech.size() && !found; ++i) {
+          const Vec3 &a = outline.leech[i - 1], &b = outline.leech[i];
+          if ((a.z() - f.L.z()) * (b.z() - f.L.z()) <= 0 && a.z() != b.z()) {
+            f.R = a + (f.L.z() - a.z()) / (b.z() - a.z()) * (b - a);
+            found = true;
+          }
         }
-      }
-      if (!found)
-        throw AnalysisError("[cutSections] horizontal plane at z = " + std::to_string(f.L.z()) +
-                            " m does not cross the leech");
-    } else {
-      f.R = pointAtFraction(outline.leech, t);
-    }
-    f.chord = (f.R - f.L).norm();
-    if (f.chord <= 0) throw AnalysisError("[cutSections] zero chord at fraction " + std::to_string(t));
-    f.c_hat = (f.R - f.L) / f.chord;
-    Vec3 m0 = p.plane == "horizontal" ? Vec3::UnitZ() : f.c_hat.cross(corner_normal);
-    if (m0.norm() < 1e-9) m0 = f.c_hat.cross(Vec3::UnitZ());
-    m0.normalize();
-    const Vec3 e0 = f.c_hat.cross(m0);
-
-    double phi = 0;
-    Cut cut;
-    auto cutAt = [&](double angle) {
-      f.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
-      f.y_hat = f.m.cross(f.c_hat);
-      auto cuts = cutMesh(mesh, f.L, f.m);
-      std::string why;
-      if (!pickCut(cuts, f, p.max_bridged_gap, cut, why))
-        throw AnalysisError("[cutSections] the section plane at fraction " + formatFixed(t, 3) + " " + why);
-    };
-    cutAt(0);
-    s.converged = true;
-    if (p.plane == "normal") {
-      s.converged = false;
-      for (int it = 0; it < p.max_iterations; ++it) {
-        const auto xy = toChordCoords(cut, f);
-        const size_t imax = maxDepthIndex(xy, f.chord);
-        const uint32_t tri = cut.triangles[std::min(imax, cut.triangles.size() - 1)];
-        const Vec3 n = surfaceNormalNear(mesh, cut.points[imax], p.normal_radius * f.chord, tri);
-        const Vec3 e = f.c_hat.cross(f.m);
-        const double out_of_plane = std::asin(std::clamp(f.m.dot(n), -1.0, 1.0)) * kDeg;
-        if (std::abs(out_of_plane) <= p.normal_tolerance_deg) {
-          s.converged = true;
-          break;
-        }
-        const double en = e.dot(n);
-        if (std::abs(en) < 1e-9) break;
-        phi += std::atan(-f.m.dot(n) / en);
-        if (std::abs(phi) * kDeg > p.max_tilt_deg) {
-          phi = std::copysign(p.max_tilt_deg / kDeg, phi);
-          cutAt(phi);
-          break;
-        }
-        cutAt(phi);
-      }
-      if (!s.converged)
-        result.warnings.push_back("section " + std::to_string(t) + ": the plane did not reach the surface normal within " +
-                                  std::to_string(p.normal_tolerance_deg) + " deg");
-    }
-    s.plane_tilt_deg = phi * kDeg;
-    s.plane_normal = f.m;
-    s.luff_point = f.L;
-    s.leech_point = f.R;
-    const auto xy = toChordCoords(cut, f);
-    s.curve_samples = xy.size();
-    auto bridged = [&](double x) {
-      for (const Bridge& b : cut.bridges)
-        if (x > b.x0 && x < b.x1) return true;
-      return false;
-    };
-    for (const Bridge& b : cut.bridges) s.bridged_pct += 100.0 * (b.x1 - b.x0) / f.chord;
-    if (!cut.bridges.empty())
-      result.warnings.push_back("section " + formatFixed(t, 3) + ": a hole in the scan, " +
-                                formatFixed(s.bridged_pct, 0) + " % of the chord, is bridged");
-
-    // Maximum depth: refined by a cubic through the points around the deepest one.
-    const size_t imax = maxDepthIndex(xy, f.chord);
-    const double side = xy[imax].y() >= 0 ? 1.0 : -1.0;
-    double depth = std::abs(xy[imax].y()), depth_x = xy[imax].x();
-    double sd_depth = p.sensor_sigma_m, sd_x = spacing;
-    {
-      std::vector<Eigen::Vector2d> win;
-      for (const auto& v : xy)
-        if (std::abs(v.x() - depth_x) <= p.peak_window * f.chord) win.emplace_back(v.x(), side * v.y());
-      Peak peak;
-      if (fitPeak(win, depth_x, p.peak_window * f.chord, peak)) {
-        const double inflate =
-            std::sqrt(correlationInflation(win.size(), 2 * p.peak_window * f.chord, p.noise_correlation_m));
-        depth = peak.depth;
-        depth_x = peak.x;
-        sd_depth = peak.sd_depth * inflate;
-        sd_x = peak.sd_x * inflate;
-        // A bridge under the crest's window carries its own uncertainty into the
-        // depth; a crest inside it could stand anywhere across it.
-        for (const Bridge& b : cut.bridges) {
-          if (b.x1 < depth_x - p.peak_window * f.chord || b.x0 > depth_x + p.peak_window * f.chord) continue;
-          sd_depth = std::hypot(sd_depth, b.sd);
-          if (depth_x > b.x0 && depth_x < b.x1) sd_x = std::hypot(sd_x, (b.x1 - b.x0) / std::sqrt(12.0));
-        }
+        if (!found)
+          throw AnalysisError("[cutSections] horizontal plane at z = " + std::to_string(f.L.z()) +
+                              " m does not cross the leech");
       } else {
-        result.warnings.push_back("section " + std::to_string(t) +
-                                  ": no crest in the peak fit; the deepest cut point is used");
+        f.R = pointAtFraction(outline.leech, t);
       }
+      f.chord = (f.R - f.L).norm();
+      if (f.chord <= 0) throw AnalysisError("[cutSections] zero chord at fraction " + std::to_string(t));
+      f.c_hat = (f.R - f.L) / f.chord;
+      Vec3 m0 = p.plane == "horizontal" ? Vec3::UnitZ() : f.c_hat.cross(corner_normal);
+      if (m0.norm() < 1e-9) m0 = f.c_hat.cross(Vec3::UnitZ());
+      m0.normalize();
+      const Vec3 e0 = f.c_hat.cross(m0);
+
+      double phi = 0;
+      Cut cut;
+      auto cutAt = [&](double angle) {
+        f.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
+        f.y_hat = f.m.cross(f.c_hat);
+        auto cuts = cutMesh(mesh, f.L, f.m);
+        std::string why;
+        if (!pickCut(cuts, f, p.max_bridged_gap, cut, why))
+          throw AnalysisError("[cutSections] the section plane at fraction " + formatFixed(t, 3) + " " + why);
+      };
+      cutAt(0);
+      s.converged = true;
+      if (p.plane == "normal") {
+        s.converged = false;
+        for (int it = 0; it < p.max_iterations; ++it) {
+          const auto xy = toChordCoords(cut, f);
+          const size_t imax = maxDepthIndex(xy, f.chord);
+          const uint32_t tri = cut.triangles[std::min(imax, cut.triangles.size() - 1)];
+          const Vec3 n = surfaceNormalNear(mesh, cut.points[imax], p.normal_radius * f.chord, tri);
+          const Vec3 e = f.c_hat.cross(f.m);
+          const double out_of_plane = std::asin(std::clamp(f.m.dot(n), -1.0, 1.0)) * kDeg;
+          if (std::abs(out_of_plane) <= p.normal_tolerance_deg) {
+            s.converged = true;
+            break;
+          }
+          const double en = e.dot(n);
+          if (std::abs(en) < 1e-9) break;
+          phi += std::atan(-f.m.dot(n) / en);
+          if (std::abs(phi) * kDeg > p.max_tilt_deg) {
+            phi = std::copysign(p.max_tilt_deg / kDeg, phi);
+            cutAt(phi);
+            break;
+          }
+          cutAt(phi);
+        }
+        if (!s.converged)
+          result.warnings.push_back("section " + std::to_string(t) + ": the plane did not reach the surface normal within " +
+                                    std::to_string(p.normal_tolerance_deg) + " deg");
+      }
+      s.plane_tilt_deg = phi * kDeg;
+      s.plane_normal = f.m;
+      s.luff_point = f.L;
+      s.leech_point = f.R;
+      const auto xy = toChordCoords(cut, f);
+      s.curve_samples = xy.size();
+      auto bridged = [&](double x) {
+        for (const Bridge& b : cut.bridges)
+          if (x > b.x0 && x < b.x1) return true;
+        return false;
+      };
+      for (const Bridge& b : cut.bridges) s.bridged_pct += 100.0 * (b.x1 - b.x0) / f.chord;
+      if (!cut.bridges.empty())
+        result.warnings.push_back("section " + formatFixed(t, 3) + ": a hole in the scan, " +
+                                  formatFixed(s.bridged_pct, 0) + " % of the chord, is bridged");
+
+      // Maximum depth: refined by a cubic through the points around the deepest one.
+      const size_t imax = maxDepthIndex(xy, f.chord);
+      const double side = xy[imax].y() >= 0 ? 1.0 : -1.0;
+      double depth = std::abs(xy[imax].y()), depth_x = xy[imax].x();
+      double sd_depth = p.sensor_sigma_m, sd_x = spacing;
+      {
+        std::vector<Eigen::Vector2d> win;
+        for (const auto& v : xy)
+          if (std::abs(v.x() - depth_x) <= p.peak_window * f.chord) win.emplace_back(v.x(), side * v.y());
+        Peak peak;
+        if (fitPeak(win, depth_x, p.peak_window * f.chord, peak)) {
+          const double inflate =
+              std::sqrt(correlationInflation(win.size(), 2 * p.peak_window * f.chord, p.noise_correlation_m));
+          depth = peak.depth;
+          depth_x = peak.x;
+          sd_depth = peak.sd_depth * inflate;
+          sd_x = peak.sd_x * inflate;
+          // A bridge under the crest's window carries its own uncertainty into the
+          // depth; a crest inside it could stand anywhere across it.
+          for (const Bridge& b : cut.bridges) {
+            if (b.x1 < depth_x - p.peak_window * f.chord || b.x0 > depth_x + p.peak_window * f.chord) continue;
+            sd_depth = std::hypot(sd_depth, b.sd);
+            if (depth_x > b.x0 && depth_x < b.x1) sd_x = std::hypot(sd_x, (b.x1 - b.x0) / std::sqrt(12.0));
+          }
+        } else {
+          result.warnings.push_back("section " + std::to_string(t) +
+                                    ": no crest in the peak fit; the deepest cut point is used");
+        }
+      }
+      s.max_camber_point = f.L + depth_x * f.c_hat + side * depth * f.y_hat;
+
+      // Entry and exit: quadratic over the first / last end_window of chord, slope at the end.
+      auto endAngle = [&](bool at_luff, double& sd_deg) {
+        std::vector<Eigen::Vector2d> win;
+        const double x_end = at_luff ? 0.0 : f.chord;
+        for (const auto& v : xy)  // measured points only: a bridge is no evidence of the end's slope
+          if (std::abs(v.x() - x_end) <= p.end_window * f.chord && !bridged(v.x())) win.emplace_back(v.x(), side * v.y());
+        const QuadFit q = fitQuadratic(win, x_end, 0.0);
+        if (!q.ok) {
+          sd_deg = std::numeric_limits<double>::quiet_NaN();
+          result.warnings.push_back("section " + std::to_string(t) + ": too few points for the " +
+                                    (at_luff ? "entry" : "exit") + " angle");
+          return std::numeric_limits<double>::quiet_NaN();
+        }
+        const double slope = at_luff ? q.c[1] : -q.c[1];
+        const double inflate = correlationInflation(win.size(), p.end_window * f.chord, p.noise_correlation_m);
+        sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDeg;
+        return std::atan(slope) * kDeg;
+      };
+
+      SectionParameters& v = s.value;
+      SectionParameters& u = s.uncertainty;
+      v.chord_m = f.chord;
+      v.camber_pct = 100.0 * depth / f.chord;
+      v.draft_pct = 100.0 * depth_x / f.chord;
+      v.twist_deg = twistDeg(f.L, f.R);
+      v.entry_deg = endAngle(true, u.entry_deg);
+      v.exit_deg = endAngle(false, u.exit_deg);
+      const double chord_dir_sd = sigma_ends / f.chord;  // rad
+      const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
+      u.chord_m = sigma_ends;
+      // The chord line moves by about half the ends' uncertainty at the crest.
+      u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.25 * sigma_ends * sigma_ends) / f.chord;
+      u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_luff * sigma_luff) / f.chord;
+      u.twist_deg = chord_xy > 0 ? sigma_ends / chord_xy * kDeg : 180.0;
+      u.entry_deg = std::hypot(u.entry_deg, chord_dir_sd * kDeg);
+      u.exit_deg = std::hypot(u.exit_deg, chord_dir_sd * kDeg);
+
+      std::vector<Vec3> line = cut.points;
+      s.curve = resampleCurve(line, p.curve_points);
+      result.sections.push_back(std::move(s));
+    } catch (const AnalysisError& e) {
+      std::string why = e.what();
+      const std::string prefix = "[cutSections] ";
+      if (why.rfind(prefix, 0) == 0) why.erase(0, prefix.size());
+      result.unmeasured.push_back({t, why});
+      result.warnings.push_back("section " + formatFixed(t, 3) + " not measured: " + why);
     }
-    s.max_camber_point = f.L + depth_x * f.c_hat + side * depth * f.y_hat;
-
-    // Entry and exit: quadratic over the first / last end_window of chord, slope at the end.
-    auto endAngle = [&](bool at_luff, double& sd_deg) {
-      std::vector<Eigen::Vector2d> win;
-      const double x_end = at_luff ? 0.0 : f.chord;
-      for (const auto& v : xy)  // measured points only: a bridge is no evidence of the end's slope
-        if (std::abs(v.x() - x_end) <= p.end_window * f.chord && !bridged(v.x())) win.emplace_back(v.x(), side * v.y());
-      const QuadFit q = fitQuadratic(win, x_end, 0.0);
-      if (!q.ok) {
-        sd_deg = std::numeric_limits<double>::quiet_NaN();
-        result.warnings.push_back("section " + std::to_string(t) + ": too few points for the " +
-                                  (at_luff ? "entry" : "exit") + " angle");
-        return std::numeric_limits<double>::quiet_NaN();
-      }
-      const double slope = at_luff ? q.c[1] : -q.c[1];
-      const double inflate = correlationInflation(win.size(), p.end_window * f.chord, p.noise_correlation_m);
-      sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDeg;
-      return std::atan(slope) * kDeg;
-    };
-
-    SectionParameters& v = s.value;
-    SectionParameters& u = s.uncertainty;
-    v.chord_m = f.chord;
-    v.camber_pct = 100.0 * depth / f.chord;
-    v.draft_pct = 100.0 * depth_x / f.chord;
-    v.twist_deg = twistDeg(f.L, f.R);
-    v.entry_deg = endAngle(true, u.entry_deg);
-    v.exit_deg = endAngle(false, u.exit_deg);
-    const double chord_dir_sd = sigma_ends / f.chord;  // rad
-    const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
-    u.chord_m = sigma_ends;
-    // The chord line moves by about half the ends' uncertainty at the crest.
-    u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.25 * sigma_ends * sigma_ends) / f.chord;
-    u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_luff * sigma_luff) / f.chord;
-    u.twist_deg = chord_xy > 0 ? sigma_ends / chord_xy * kDeg : 180.0;
-    u.entry_deg = std::hypot(u.entry_deg, chord_dir_sd * kDeg);
-    u.exit_deg = std::hypot(u.exit_deg, chord_dir_sd * kDeg);
-
-    std::vector<Vec3> line = cut.points;
-    s.curve = resampleCurve(line, p.curve_points);
-    result.sections.push_back(std::move(s));
   }
-  if (!result.sections.empty()) {
+  if (result.sections.empty()) {
+    std::string why;
+    for (const UnmeasuredSection& u : result.unmeasured) why += (why.empty() ? "" : "; ") + u.reason;
+    throw AnalysisError("[cutSections] " + (result.unmeasured.size() == 1 ? why : "no section could be measured: " + why));
+  }
+  {
     const Section& low = result.sections.front();
+    if (!result.unmeasured.empty() && result.unmeasured.front().fraction < low.fraction)
+      result.warnings.push_back("twist_rel is relative to the lowest measured section, at fraction " +
+                                formatFixed(low.fraction, 3));
     for (Section& s : result.sections) {
       s.value.twist_rel_deg = s.value.twist_deg - low.value.twist_deg;
       s.uncertainty.twist_rel_deg =

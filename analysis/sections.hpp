@@ -31,8 +31,9 @@ struct SectionParams {
   // section curve. Gaps up to 10 % of the chord are read as they are; inside
   // the chord, wider ones up to this fraction are bridged by a cubic that keeps
   // the slopes on either side, with a warning and the bridge's own uncertainty.
-  // A curve that leaves over 10 % uncovered at an end is refused, and the entry
-  // and exit fits read measured points only, never a bridge's.
+  // A curve that leaves over 10 % uncovered at an end, or crosses a wider hole,
+  // leaves its section unmeasured (the others stand); the entry and exit fits
+  // read measured points only, never a bridge's.
   double max_bridged_gap = 0.35;
 };
 
@@ -60,16 +61,29 @@ struct Section {
   double bridged_pct = 0;             // % of the chord bridged across holes (see max_bridged_gap)
 };
 
+// A section asked for whose plane found no curve spanning the chord (a hole too
+// wide to bridge, an end of the sail not scanned), and why.
+struct UnmeasuredSection {
+  double fraction = 0;
+  std::string reason;                 // "the section plane at fraction 0.750 leaves 14 % of the chord ..."
+};
+
 struct SectionAnalysis {
-  std::vector<Section> sections;      // ordered by fraction
+  std::vector<Section> sections;      // the measured ones, ordered by fraction
+  std::vector<UnmeasuredSection> unmeasured;  // the rest of those asked for, ordered by fraction
   std::vector<std::string> warnings;
 };
 
 // The fractions `params` asks for, validated and sorted.
 std::vector<double> sectionFractions(const SectionParams& params);
 
-// Throws InvalidInput for bad parameters and AnalysisError when a section plane
-// does not cut the mesh between luff and leech.
+// Throws InvalidInput for bad parameters (cutSections checks them first; the
+// pipeline before it starts).
+void checkSectionParams(const SectionParams& params);
+
+// Each section the parameters ask for, measured or (with a warning) unmeasured.
+// twist_rel is relative to the lowest measured section. Throws InvalidInput for
+// bad parameters and AnalysisError when no section can be measured.
 SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const SectionParams& params = {});
 
 // Twist per SPEC §5: angle in the XY plane between +X and the chord vector from

@@ -44,7 +44,16 @@ void printTable(const SailAnalysis& a) {
               a.luff.lufa_position_pct, 1000 * a.luff.lusw_sag_m, a.luff.lusw_position_pct);
   std::printf("%8s %9s %14s %14s %14s %14s %13s %13s\n", "height", "chord m", "camber %", "draft %", "twist deg",
               "twist rel", "entry deg", "exit deg");
-  for (const Section& s : a.sections.sections) {
+  // Measured and unmeasured sections in height order.
+  const auto& measured = a.sections.sections;
+  const auto& unmeasured = a.sections.unmeasured;
+  for (size_t i = 0, j = 0; i < measured.size() || j < unmeasured.size();) {
+    if (j < unmeasured.size() && (i == measured.size() || unmeasured[j].fraction < measured[i].fraction)) {
+      std::printf("%7.0f%% not measured: %s\n", 100 * unmeasured[j].fraction, unmeasured[j].reason.c_str());
+      ++j;
+      continue;
+    }
+    const Section& s = measured[i++];
     const SectionParameters &v = s.value, &u = s.uncertainty;
     std::printf("%7.0f%% %9.3f %6.2f ±%5.2f %6.1f ±%5.1f %6.2f ±%5.2f %6.2f ±%5.2f %5.1f ±%5.1f %5.1f ±%5.1f\n",
                 100 * s.fraction, v.chord_m, v.camber_pct, u.camber_pct, v.draft_pct, u.draft_pct, v.twist_deg,

@@ -749,6 +749,9 @@ TrimReportData prepareTrimReport(const TrimReportParams& p, const Progress& prog
       cs.fraction = fs.fraction;
       cs.flying = fs.value;
       cs.flying_u = fs.uncertainty;
+      // A design section left unmeasured shows as "–", not as a design of zeros.
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      cs.design = cs.design_u = {nan, nan, nan, nan, nan, nan, nan};
       for (const Section& ds : r.design_sections.sections)
         if (std::abs(ds.fraction - fs.fraction) < 1e-9) cs.design = ds.value, cs.design_u = ds.uncertainty;
       c.sections.push_back(cs);

@@ -71,6 +71,7 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
     try {
       SectionParams sp;
       for (const auto& s : scene.sections.sections) sp.fractions.push_back(s.fraction);
+      for (const auto& u : scene.sections.unmeasured) sp.fractions.push_back(u.fraction);
       const MeshSections ms = analyzeMeshSections(scene.design, OutlineParams{}, sp);
       scene.design_sections = ms.sections;
       scene.deltas = sectionDeltas(scene.design_sections, scene.sections);

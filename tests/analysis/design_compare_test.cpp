@@ -257,6 +257,38 @@ TEST(DesignCompare, DeeperFlyingShapeShowsAsPositiveDistancesAndCamberDeltas) {
   EXPECT_GT(c.leeward.y(), 0.7);
 }
 
+TEST(DesignCompare, ASectionUnmeasuredOnOneSideHasNoDeltaAndTwistRelStartsAtTheLowestShared) {
+  // Asked for 0.25, 0.5 and 0.75 on both; the flying 0.25 was not measured.
+  auto section = [](double f, double camber, double twist, double twist_rel) {
+    Section s;
+    s.fraction = f;
+    s.value.camber_pct = camber;
+    s.value.twist_deg = twist;
+    s.value.twist_rel_deg = twist_rel;
+    return s;
+  };
+  SectionAnalysis design, flying;
+  design.sections = {section(0.25, 10, 20, 0), section(0.5, 11, 24, 4), section(0.75, 12, 30, 10)};
+  flying.sections = {section(0.5, 12, 27, 0), section(0.75, 14, 35, 8)};
+  flying.unmeasured = {{0.25, "leaves 14 % of the chord at the leech uncovered (at most 10 %)"}};
+  const std::vector<SectionDelta> d = sectionDeltas(design, flying);
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_DOUBLE_EQ(d[0].fraction, 0.5);
+  EXPECT_DOUBLE_EQ(d[1].fraction, 0.75);
+  EXPECT_DOUBLE_EQ(d[0].delta.camber_pct, 1);
+  EXPECT_DOUBLE_EQ(d[1].delta.camber_pct, 2);
+  EXPECT_DOUBLE_EQ(d[1].delta.twist_deg, 5);
+  // From 0.5 on both sides: the design twists 6° from there, the flying sail 8°.
+  EXPECT_DOUBLE_EQ(d[0].design.twist_rel_deg, 0);
+  EXPECT_DOUBLE_EQ(d[1].design.twist_rel_deg, 6);
+  EXPECT_DOUBLE_EQ(d[1].flying.twist_rel_deg, 8);
+  EXPECT_DOUBLE_EQ(d[1].delta.twist_rel_deg, 2);
+  // Unmeasured on the design side instead: the same pairs.
+  std::swap(design.sections, flying.sections);
+  std::swap(design.unmeasured, flying.unmeasured);
+  EXPECT_EQ(sectionDeltas(design, flying).size(), 2u);
+}
+
 TEST(DesignCompare, ThrowsOnBadInput) {
   expectInvalidInput([] { DesignDistance d{Mesh{}}; }, {"[DesignDistance]", "no triangles"});
   Mesh bad;
@@ -277,6 +309,9 @@ TEST(DesignCompare, ThrowsOnBadInput) {
   expectInvalidInput([&] { sectionDeltas(a, b); }, {"[sectionDeltas]", "0.75"});
   b.sections.resize(1);
   expectInvalidInput([&] { sectionDeltas(a, b); }, {"[sectionDeltas]"});
+  // Asked for different fractions, one of them unmeasured: still not the same sections.
+  b.unmeasured = {{0.75, "crosses a hole"}};
+  expectInvalidInput([&] { sectionDeltas(a, b); }, {"[sectionDeltas]", "0.75"});
   const Mesh tri = gridMesh(1, [](double s, double t) { return Vec3(s, t, 0); });
   expectInvalidInput([&] { sampleMesh(Mesh{}, 10); }, {"[sampleMesh]", "no triangles"});
   expectInvalidInput([&] { sampleMesh(tri, 0); }, {"[sampleMesh]", "points"});

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "analysis/analysis_json.hpp"
 #include "analysis/errors.hpp"
 #include "analysis/pipeline.hpp"
 #include "analysis/sail_generator.hpp"
@@ -374,13 +375,67 @@ TEST(Pipeline, ABridgeOfAWholeChordIsRefused) {
   }
 }
 
-TEST(Pipeline, AHoleWiderThanTheBridgeIsOneErrorNamingTheSection) {
+TEST(Pipeline, AHoleWiderThanTheBridgeLeavesItsSectionUnmeasuredAndTheOthersStand) {
+  // A hole 44 % of the mid section's chord wide: that section cannot be measured,
+  // but it no longer takes the whole analysis with it.
   const SailDesign design = exampleDesign(SailType::Main);
   const SailSurface truth(design);
   const double chord = truth.section(0.5).chord_m;
   const Cloud holed = withHole(sampleSail(design, scan(40000)), truth, 0.5, 0.45, 0.22 * chord);
-  expectThrowWith<AnalysisError>([&] { analyzeSail(holed); },
+  const SailAnalysis a = analyzeSail(holed);
+  ASSERT_EQ(a.sections.unmeasured.size(), 1u);
+  EXPECT_DOUBLE_EQ(a.sections.unmeasured[0].fraction, 0.5);
+  const std::string& why = a.sections.unmeasured[0].reason;
+  EXPECT_NE(why.find("fraction 0.500 crosses a hole"), std::string::npos) << why;
+  EXPECT_NE(why.find("bridged up to 35 %"), std::string::npos) << why;
+  bool warned = false;
+  for (const std::string& w : a.sections.warnings) warned = warned || w.find("section 0.500 not measured") != std::string::npos;
+  EXPECT_TRUE(warned);
+  // The sections either side meet the clean targets, and twist_rel still starts at the lowest.
+  ASSERT_EQ(a.sections.sections.size(), 2u);
+  EXPECT_DOUBLE_EQ(a.sections.sections[0].fraction, 0.25);
+  EXPECT_DOUBLE_EQ(a.sections.sections[1].fraction, 0.75);
+  for (const Section& s : a.sections.sections) {
+    const KnownSection k = truth.section(s.fraction);
+    SCOPED_TRACE("section at " + std::to_string(s.fraction));
+    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, kClean.camber_pct);
+    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, kClean.draft_pct);
+    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, kClean.twist_deg);
+    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, kClean.end_deg);
+    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, kClean.end_deg);
+  }
+  EXPECT_DOUBLE_EQ(a.sections.sections[0].value.twist_rel_deg, 0.0);
+  // The JSON says which section is missing and why.
+  const nlohmann::json j = analysisToJson(a);
+  ASSERT_EQ(j["unmeasured_sections"].size(), 1u);
+  EXPECT_DOUBLE_EQ(j["unmeasured_sections"][0]["fraction"].get<double>(), 0.5);
+  EXPECT_EQ(j["unmeasured_sections"][0]["reason"].get<std::string>(), why);
+  EXPECT_EQ(j["sections"].size(), 2u);
+}
+
+TEST(Pipeline, WhenNoSectionCanBeMeasuredTheAnalysisIsOneErrorNamingIt) {
+  const SailDesign design = exampleDesign(SailType::Main);
+  const SailSurface truth(design);
+  const double chord = truth.section(0.5).chord_m;
+  const Cloud holed = withHole(sampleSail(design, scan(40000)), truth, 0.5, 0.45, 0.22 * chord);
+  AnalysisParams p;
+  p.sections.fractions = {0.5};
+  expectThrowWith<AnalysisError>([&] { analyzeSail(holed, p); },
                                  {"[cutSections]", "fraction 0.500", "crosses a hole", "bridged up to 35 %"});
+}
+
+TEST(Pipeline, ABadSectionParameterIsReportedBeforeAnyWork) {
+  // A flat wall is refused by sail picking; a bad section parameter must be named
+  // first, not after a whole analysis has run.
+  Cloud wall;
+  for (int i = 0; i < 60; ++i)
+    for (int j = 0; j < 60; ++j) wall.points.emplace_back(0.05 * i, 0.0, 0.05 * j);
+  AnalysisParams p;
+  p.sections.curve_points = 1;
+  expectThrowWith<InvalidInput>([&] { analyzeSail(wall, p); }, {"[cutSections]", "curve_points must be >= 2"});
+  p.sections.curve_points = 61;
+  p.sections.max_tilt_deg = 90;
+  expectThrowWith<InvalidInput>([&] { analyzeSail(wall, p); }, {"[cutSections]", "max_tilt_deg must be in (0, 90)"});
 }
 
 TEST(Pipeline, ACleanWindTunnelModelKeepsItsTopSectionWithinTheCleanTargets) {
