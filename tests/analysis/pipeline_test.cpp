@@ -48,21 +48,23 @@ ScanSimulation scan(size_t points, uint64_t seed = 1, double noise_m = 0.0) {
   return sim;
 }
 
+void expectSectionMatches(const Section& s, const SailSurface& truth, const Tolerance& tol) {
+  const KnownSection k = truth.section(s.fraction);
+  SCOPED_TRACE("section at " + std::to_string(s.fraction));
+  EXPECT_NEAR(s.value.camber_pct, k.camber_pct, tol.camber_pct);
+  EXPECT_NEAR(s.value.draft_pct, k.draft_pct, tol.draft_pct);
+  EXPECT_NEAR(s.value.twist_deg, k.twist_deg, tol.twist_deg);
+  EXPECT_NEAR(s.value.entry_deg, k.entry_deg, tol.end_deg);
+  EXPECT_NEAR(s.value.exit_deg, k.exit_deg, tol.end_deg);
+  EXPECT_TRUE(s.converged);
+  // Every parameter carries a positive, finite uncertainty.
+  EXPECT_GT(s.uncertainty.camber_pct, 0);
+  EXPECT_TRUE(std::isfinite(s.uncertainty.entry_deg));
+}
+
 void expectSectionsMatch(const SailAnalysis& a, const SailSurface& truth, const Tolerance& tol) {
   ASSERT_EQ(a.sections.sections.size(), 3u);
-  for (const Section& s : a.sections.sections) {
-    const KnownSection k = truth.section(s.fraction);
-    SCOPED_TRACE("section at " + std::to_string(s.fraction));
-    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, tol.camber_pct);
-    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, tol.draft_pct);
-    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, tol.twist_deg);
-    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, tol.end_deg);
-    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, tol.end_deg);
-    EXPECT_TRUE(s.converged);
-    // Every parameter carries a positive, finite uncertainty.
-    EXPECT_GT(s.uncertainty.camber_pct, 0);
-    EXPECT_TRUE(std::isfinite(s.uncertainty.entry_deg));
-  }
+  for (const Section& s : a.sections.sections) expectSectionMatches(s, truth, tol);
   const Section& low = a.sections.sections.front();
   EXPECT_DOUBLE_EQ(low.value.twist_rel_deg, 0.0);
   for (const Section& s : a.sections.sections)
@@ -395,15 +397,7 @@ TEST(Pipeline, AHoleWiderThanTheBridgeLeavesItsSectionUnmeasuredAndTheOthersStan
   ASSERT_EQ(a.sections.sections.size(), 2u);
   EXPECT_DOUBLE_EQ(a.sections.sections[0].fraction, 0.25);
   EXPECT_DOUBLE_EQ(a.sections.sections[1].fraction, 0.75);
-  for (const Section& s : a.sections.sections) {
-    const KnownSection k = truth.section(s.fraction);
-    SCOPED_TRACE("section at " + std::to_string(s.fraction));
-    EXPECT_NEAR(s.value.camber_pct, k.camber_pct, kClean.camber_pct);
-    EXPECT_NEAR(s.value.draft_pct, k.draft_pct, kClean.draft_pct);
-    EXPECT_NEAR(s.value.twist_deg, k.twist_deg, kClean.twist_deg);
-    EXPECT_NEAR(s.value.entry_deg, k.entry_deg, kClean.end_deg);
-    EXPECT_NEAR(s.value.exit_deg, k.exit_deg, kClean.end_deg);
-  }
+  for (const Section& s : a.sections.sections) expectSectionMatches(s, truth, kClean);
   EXPECT_DOUBLE_EQ(a.sections.sections[0].value.twist_rel_deg, 0.0);
   // The JSON says which section is missing and why.
   const nlohmann::json j = analysisToJson(a);
