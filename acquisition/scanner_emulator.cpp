@@ -140,12 +140,16 @@ void ScannerEmulator::runSession(int fd) {
     return true;
   };
   char buf[4096];
-  while (!stop_) {
+  // When scan k of the stream starts (scan k + 1's start is when scan k is due).
+  // Read at each use: a request may change the frequency or restart the stream.
+  auto scanTime = [&](uint64_t k) {
     const double period_s = 100.0 / s.frequency;
+    return s.stream_start + std::chrono::microseconds(roundToInt(static_cast<double>(k) * period_s * 1e6));
+  };
+  while (!stop_) {
     int wait_ms = 20;
-    Clock::time_point due{};
     if (s.streaming && s.measuring) {
-      due = s.stream_start + std::chrono::microseconds(roundToInt((s.next_scan + 1) * period_s * 1e6));
+      const Clock::time_point due = scanTime(s.next_scan + 1);
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(due - Clock::now()).count();
       wait_ms = static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(left, 20)));
     }
@@ -179,11 +183,8 @@ void ScannerEmulator::runSession(int fd) {
       }
     }
     // Due as the stream now stands: a request just read may have started it (or the spin-up holds it).
-    if (s.streaming && s.measuring)
-      due = s.stream_start + std::chrono::microseconds(roundToInt((s.next_scan + 1) * period_s * 1e6));
-    if (s.streaming && s.measuring && Clock::now() >= due) {
-      const Clock::time_point scan_start =
-          s.stream_start + std::chrono::microseconds(roundToInt(s.next_scan * period_s * 1e6));
+    if (s.streaming && s.measuring && Clock::now() >= scanTime(s.next_scan + 1)) {
+      const Clock::time_point scan_start = scanTime(s.next_scan);
       ++s.next_scan;
       if (!sendAll(frameCola(binary ? ColaDialect::kBinary : ColaDialect::kAscii,
                              scanPayload(binary, false, scan_start))))
