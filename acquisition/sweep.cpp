@@ -63,8 +63,21 @@ Vec3 sweepPointPosition(const UnitConfig& unit, double r, double alpha, double b
   return unit.pose * unitPoint(r, alpha, beta, unit.p_m, unit.theta_rad);
 }
 
+void validateSweepOptions(const SweepOptions& o) {
+  auto need = [](double v, const char* what) {
+    if (!(v > 0 && std::isfinite(v)))
+      throw InvalidInput(std::string("[runSweep] ") + what + " must be > 0 (got " + formatFixed(v, 3) + ")");
+  };
+  need(o.home_timeout_s, "home_timeout_s");
+  need(o.positioning_speed_deg_s, "positioning_speed_deg_s");
+  need(o.reply_timeout_s, "reply_timeout_s");
+  need(o.scan_timeout_s, "scan_timeout_s");
+  need(o.ready_timeout_s, "ready_timeout_s");
+}
+
 Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progress& progress) {
   validateUnit(unit);
+  validateSweepOptions(options);
   Sweep sweep;
   sweep.unit = unit.name;
 
@@ -111,7 +124,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
       const double left = deadline - hostTimeSeconds();
       if (left <= 0)
         throw ScannerError("[runSweep] " + unit.name + ": the scanner streamed no scan within " +
-                           std::to_string(static_cast<int>(std::lround(options.ready_timeout_s))) +
+                           formatFixed(options.ready_timeout_s, options.ready_timeout_s == std::round(options.ready_timeout_s) ? 0 : 1) +
                            " s of its start-up (device state " + std::to_string(startup.device_state) +
                            (startup.device_state == 0 ? ", busy" : "") + ")");
       const ScanBatch first = scanner.receiveScans(1, left);

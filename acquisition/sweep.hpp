@@ -15,6 +15,7 @@
 
 namespace sailshape {
 
+// Every duration and speed must be > 0: runSweep throws InvalidInput otherwise.
 struct SweepOptions {
   bool home = true;                  // seek the home sensor first
   double home_timeout_s = 60;
@@ -58,6 +59,9 @@ struct Sweep {
   double beta_start_deg = 0, beta_end_deg = 0;  // turntable angles actually covered
   std::vector<std::string> warnings;
 };
+
+// Throws InvalidInput naming the first duration or speed that is not > 0.
+void validateSweepOptions(const SweepOptions& options);
 
 // Runs the sweep on the unit's scanner (TCP) and turntable (serial). Throws TurntableError or
 // ScannerError when the set-up fails (no home, refused login, no scanner); faults after streaming

@@ -104,6 +104,10 @@ void sendTrigger(const std::vector<TriggerEndpoint>& to, uint64_t id) {
 SynchronisedSweeps runSynchronisedSweeps(const std::vector<UnitConfig>& units, const SyncOptions& options,
                                          const Progress& progress) {
   const size_t n = units.size();
+  validateSweepOptions(options.sweep);
+  if (!(options.ready_timeout_s > 0 && std::isfinite(options.ready_timeout_s)))
+    throw InvalidInput("[runSynchronisedSweeps] ready_timeout_s must be > 0 (got " + formatFixed(options.ready_timeout_s, 3) +
+                       ")");
   if (!options.capture_paths.empty() && options.capture_paths.size() != n)
     throw InvalidInput("[runSynchronisedSweeps] capture_paths must name one capture per unit (" + std::to_string(n) +
                        " units, got " + std::to_string(options.capture_paths.size()) + ")");

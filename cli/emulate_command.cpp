@@ -34,6 +34,7 @@ struct EmulateOptions {
   double noise_scale = 1.0;
   double home_sensor_deg = 37.0;
   double duration_s = 0;
+  double spin_up_s = 0;
 };
 
 // The symlink to the pty, removed again on exit; an existing file that is not our kind of link is refused.
@@ -73,6 +74,7 @@ void run(const EmulateOptions& o) {
   sp.sensor.model = parseScannerModel(o.model);
   sp.sensor.noise_scale = o.noise_scale;
   sp.seed = o.seed;
+  sp.spin_up_s = o.spin_up_s;
   if (!o.unit.empty()) {
     const UnitConfig u = readUnitFile(o.unit);
     sp.p_m = u.p_m;
@@ -139,6 +141,11 @@ void addEmulateCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--duration", o->duration_s, "Stop after this many seconds (0: run until Ctrl-C)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--spin-up", o->spin_up_s,
+                  "Seconds after start during which the scanner is still starting, as a unit just powered on: it "
+                  "answers device state 0 (busy) and streams no scan")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->callback([o] { run(*o); });
 }
 

@@ -27,6 +27,9 @@ struct ScanOptions {
   bool trigger = false;
   bool no_home = false;
   bool quiet = false;
+  double home_timeout_s = SweepOptions{}.home_timeout_s;
+  double ready_timeout_s = SweepOptions{}.ready_timeout_s;
+  double sync_timeout_s = SyncOptions{}.ready_timeout_s;
 };
 
 std::string fileBase(const UnitConfig& u) {
@@ -57,6 +60,8 @@ void run(const ScanOptions& o) {
 
   SweepOptions so;
   so.home = !o.no_home;
+  so.home_timeout_s = o.home_timeout_s;
+  so.ready_timeout_s = o.ready_timeout_s;
   std::vector<Sweep> sweeps(units.size());
   std::vector<std::string> errors(units.size());
   double spread = 0;
@@ -64,6 +69,7 @@ void run(const ScanOptions& o) {
   if (o.trigger) {
     SyncOptions sync;
     sync.sweep = so;
+    sync.ready_timeout_s = o.sync_timeout_s;
     for (const std::string& b : bases) sync.capture_paths.push_back((fs::path(o.out) / (b + ".sscap")).string());
     const SynchronisedSweeps r = runSynchronisedSweeps(units, sync, bar.progress());
     sweeps = r.sweeps;
@@ -145,6 +151,15 @@ void addScanCommand(CLI::App& app) {
                 "Start all units together: once every unit is homed and streaming, a UDP trigger on loopback starts "
                 "their sweeps; the spread of start times is reported");
   cmd->add_flag("--no-home", o->no_home, "Skip homing (the turntable was homed since power-on)");
+  cmd->add_option("--home-timeout", o->home_timeout_s, "Longest wait for a turntable to find its home sensor, seconds")
+      ->capture_default_str();
+  cmd->add_option("--ready-timeout", o->ready_timeout_s,
+                  "Longest wait, once a scanner is set up, for its first streamed scan (a unit just powered on "
+                  "answers busy and streams nothing while it spins up), seconds")
+      ->capture_default_str();
+  cmd->add_option("--sync-timeout", o->sync_timeout_s,
+                  "With --trigger: longest wait for every unit to be homed and streaming before the trigger, seconds")
+      ->capture_default_str();
   cmd->add_flag("--quiet", o->quiet, "No progress bar");
   cmd->callback([o] { run(*o); });
 }

@@ -242,6 +242,28 @@ TEST(Sweep, AUnitThatNeverStartsStreamingIsReported) {
   }
 }
 
+TEST(Sweep, ADurationOrSpeedThatIsNotPositiveIsOneErrorBeforeAnythingMoves) {
+  UnitConfig u = compactUnit(0.1, 0);
+  Rig rig(wallAt(3), u, emulatorFor(u), fastTable());
+  const std::vector<std::pair<double SweepOptions::*, std::string>> fields{
+      {&SweepOptions::home_timeout_s, "home_timeout_s"},   {&SweepOptions::positioning_speed_deg_s, "positioning_speed_deg_s"},
+      {&SweepOptions::reply_timeout_s, "reply_timeout_s"}, {&SweepOptions::scan_timeout_s, "scan_timeout_s"},
+      {&SweepOptions::ready_timeout_s, "ready_timeout_s"}};
+  for (const auto& [field, name] : fields)
+    for (double bad : {0.0, -1.0, std::nan("")}) {
+      SweepOptions o;
+      o.*field = bad;
+      try {
+        runSweep(rig.unit, o);
+        ADD_FAILURE() << name << " = " << bad;
+      } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("[runSweep] " + name + " must be > 0"), std::string::npos) << e.what();
+      }
+    }
+  // Refused before any link was opened.
+  EXPECT_EQ(rig.scanner.connections(), 0u);
+}
+
 TEST(Sweep, TurntableThatNeverFindsHome) {
   EmulatedTurntableParams tp = fastTable();
   tp.home_sensor_works = false;

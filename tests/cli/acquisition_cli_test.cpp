@@ -78,11 +78,12 @@ TEST(AcquisitionCli, HelpExplainsTheOptions) {
   const fs::path d = freshDir("help");
   auto r = runSailshape(d, "emulate --help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* opt : {"--model", "--scene", "--port", "--serial-link", "--unit", "--bind"})
+  for (const char* opt : {"--model", "--scene", "--port", "--serial-link", "--unit", "--bind", "--spin-up"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
   r = runSailshape(d, "scan --help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* opt : {"--unit", "--out", "--trigger"}) EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+  for (const char* opt : {"--unit", "--out", "--trigger", "--home-timeout", "--ready-timeout", "--sync-timeout"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
   r = runSailshape(d, "scanner calibrate --help");
   EXPECT_EQ(r.exit_code, 0);
   for (const char* opt : {"--plane", "--cylinder", "--radius", "--write-unit"})
@@ -134,6 +135,33 @@ TEST(AcquisitionCli, EmulateScanAndCalibrate) {
   const auto written = nlohmann::json::parse(readText(d / "calibrated.json"));
   EXPECT_NEAR(written["p_m"].get<double>(), cal["p_m"].get<double>(), 1e-9);
   EXPECT_EQ(written["port"].get<int>(), port);
+}
+
+TEST(AcquisitionCli, AScannerStillSpinningUpPastTheReadyTimeoutIsOneErrorAndNoScanIsWritten) {
+  const fs::path d = freshDir("spinup");
+  writeText(d / "room.json", kRoom);
+  EmulatorProcess emu(d, "--model lms511 --port 0 --spin-up 60 --scene '" + (d / "room.json").string() +
+                             "' --serial-link '" + (d / "tt").string() + "' --duration 60");
+  const int port = emu.port();
+  ASSERT_GT(port, 0) << readText(d / "emulator.txt");
+  nlohmann::json unit{{"name", "room-unit"}, {"port", port}, {"serial_device", (d / "tt").string()},
+                      {"model", "lms511"},   {"frequency_hz", 25}, {"resolution_deg", 0.1667},
+                      {"start_angle_deg", -20}, {"sweep_angle_deg", 40}, {"speed_deg_s", 90},
+                      {"acceleration_deg_s2", 900}};
+  writeText(d / "unit.json", unit.dump());
+  auto scan = [&](const std::string& out) {
+    return "scan --quiet --unit '" + (d / "unit.json").string() + "' --out '" + (d / out).string() + "'";
+  };
+  auto r = runSailshape(d, scan("out") + " --ready-timeout 1.5");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("streamed no scan within 1.5 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("busy"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "out" / "room-unit.ply"));
+  // A wait that is no wait is refused before anything is opened.
+  r = runSailshape(d, scan("out2") + " --ready-timeout 0");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("ready_timeout_s must be > 0"), std::string::npos) << r.err;
 }
 
 TEST(AcquisitionCli, ErrorsAreOneLine) {
