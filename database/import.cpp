@@ -46,7 +46,24 @@ int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, 
   nlohmann::json sail = doc.value("sail", nlohmann::json::object());
   if (doc.contains("luff")) sail["luff"] = doc["luff"];
   a.bind(4, sail.dump());
-  json_or_null(5, "diagnostics");
+  // Sections asked for but not measured ride in the diagnostics: the sections table
+  // holds measured ones only.
+  if (doc.contains("unmeasured_sections")) {
+    const nlohmann::json& u = doc["unmeasured_sections"];
+    if (!u.is_array())
+      throw InvalidInput(std::string("[") + function + "] unmeasured_sections must be an array (got " + u.dump() + ")");
+    for (const nlohmann::json& x : u) {
+      const auto fraction = x.is_object() ? number(x, "fraction") : std::nullopt;
+      if (!fraction || *fraction <= 0 || *fraction >= 1 || !x.contains("reason") || !x["reason"].is_string())
+        throw InvalidInput(std::string("[") + function +
+                           "] an unmeasured section needs a fraction in (0, 1) and a reason (got " + x.dump() + ")");
+    }
+    nlohmann::json diagnostics = doc.value("diagnostics", nlohmann::json::object());
+    diagnostics["unmeasured_sections"] = u;
+    a.bind(5, diagnostics.dump());
+  } else {
+    json_or_null(5, "diagnostics");
+  }
   a.run();
   const int64_t analysis_id = db.lastInsertId();
   if (hook) hook("analysis");

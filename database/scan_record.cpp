@@ -1,5 +1,6 @@
 #include "database/scan_record.hpp"
 
+#include <algorithm>
 #include <limits>
 
 #include "analysis/errors.hpp"
@@ -78,7 +79,22 @@ ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
     sec.curve_samples = sec.curve.size();
     r.sections.sections.push_back(std::move(sec));
   }
+  r.sections.unmeasured = unmeasuredSections(db, r.analysis_id);
   return r;
+}
+
+std::vector<UnmeasuredSection> unmeasuredSections(Database& db, int64_t analysis_id) {
+  Statement s = db.prepare("SELECT diagnostics FROM analyses WHERE id = ?");
+  s.bind(1, analysis_id);
+  std::vector<UnmeasuredSection> out;
+  if (!s.step() || s.isNull(0)) return out;
+  const nlohmann::json d = nlohmann::json::parse(s.columnText(0), nullptr, false);
+  if (d.is_discarded() || !d.is_object() || !d.contains("unmeasured_sections")) return out;
+  for (const nlohmann::json& x : d["unmeasured_sections"])
+    if (x.is_object() && x.value("fraction", nlohmann::json()).is_number() && x.value("reason", nlohmann::json()).is_string())
+      out.push_back({x["fraction"].get<double>(), x["reason"].get<std::string>()});
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.fraction < b.fraction; });
+  return out;
 }
 
 }  // namespace sailshape

@@ -22,14 +22,18 @@ struct ScanRecord {
   std::optional<double> awa_deg;
   bool has_design = false;         // the sail has a stored design mesh
   std::optional<Cloud> cloud;      // absent when only the analysis was imported
-  // The latest analysis's sections; luff/leech points are the curve's ends and
-  // max_camber_point is not stored (left zero); a parameter stored as NULL
-  // (not measurable) is NaN.
+  // The latest analysis's sections (and those it could not measure); luff/leech
+  // points are the curve's ends and max_camber_point is not stored (left zero); a
+  // parameter stored as NULL (not measurable) is NaN.
   SectionAnalysis sections;
   nlohmann::json analysis_params;  // the pipeline parameters it ran with (null when unknown)
   nlohmann::json settings;         // the acquisition settings stored with the scan (null when none)
   std::optional<Eigen::Matrix4d> registration;  // the latest scanner-to-boat transform, when registered
 };
+
+// The sections analysis `analysis_id` was asked for but could not measure, with
+// why (stored in its diagnostics by importScan); empty when there were none.
+std::vector<UnmeasuredSection> unmeasuredSections(Database& db, int64_t analysis_id);
 
 // Throws InvalidInput when there is no scan `scan_id`, DatabaseError for a damaged cloud blob.
 ScanRecord loadScanRecord(Database& db, int64_t scan_id);

@@ -8,6 +8,7 @@
 #include "database/catalog.hpp"
 #include "database/cloud_blob.hpp"
 #include "database/import.hpp"
+#include "database/scan_record.hpp"
 
 namespace sailshape {
 namespace {
@@ -100,6 +101,7 @@ ReportStep loadStep(Database& db, int64_t scan_id, const char* function) {
   }
   if (step.sections.empty())
     throw InvalidInput(std::string("[") + function + "] scan " + std::to_string(scan_id) + " has an analysis without sections");
+  step.unmeasured = unmeasuredSections(db, step.analysis_id);
   return step;
 }
 

@@ -30,6 +30,7 @@ struct ReportStep {
   std::optional<double> awa_deg, aws_m_s, drive_n, side_n, heel_moment_nm;
   std::map<std::string, double> controls;  // control-line settings as stored
   std::vector<ReportSection> sections;     // the latest analysis, by fraction
+  std::vector<UnmeasuredSection> unmeasured;  // sections it was asked for but could not measure, with why
   Cloud cloud;                             // the stored cloud; empty when none was stored
 };
 

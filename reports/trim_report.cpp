@@ -418,6 +418,10 @@ void tablePage(PdfDocument& pdf, Pages& pages, const ReportData& d, const Report
                       "* the section plane did not reach the surface normal at maximum camber; its values are less "
                       "certain than the ± says.",
                       8.5f, false, kGrey);
+  for (const UnmeasuredSection& u : step.unmeasured)
+    y = pdf.paragraph(kMargin, y, w - 2 * kMargin,
+                      fmt("The %.0f %% section was not measured: ", 100 * u.fraction) + u.reason + ".", 8.5f, false,
+                      kFlyingRed);
   y = pdf.paragraph(kMargin, y, w - 2 * kMargin,
                     "Chord: " + [&] {
                       std::string out;

@@ -833,6 +833,13 @@ void App::drawSectionTable() {
       ImGui::EndTable();
     }
   }
+  for (const UnmeasuredSection& u : s.sections.unmeasured) {
+    ImGui::Spacing();
+    ImGui::TextColored(kAccentText, "Section at f = %.2f: not measured", u.fraction);
+    ImGui::PushStyleColor(ImGuiCol_Text, kMutedText);
+    ImGui::TextWrapped("%s", u.reason.c_str());
+    ImGui::PopStyleColor();
+  }
   if (!s.warnings.empty()) {
     ImGui::Spacing();
     for (const auto& wmsg : s.warnings) ImGui::TextColored(kMutedText, "· %s", wmsg.c_str());

@@ -137,6 +137,19 @@ TEST(Import, BadInputThrowsAndStoresNothing) {
   nlohmann::json bad = analysisDoc(8.0);
   bad["sections"][2]["fraction"] = 1.5;
   EXPECT_THROW(importScan(db, meta(0, 90), &bad), InvalidInput);
+  // So is an unmeasured section without a fraction in (0, 1) or a reason.
+  for (const nlohmann::json& u : {nlohmann::json{{"fraction", 1.5}, {"reason", "x"}}, nlohmann::json{{"fraction", 0.5}},
+                                  nlohmann::json("0.5")}) {
+    nlohmann::json odd = analysisDoc(8.0);
+    odd["unmeasured_sections"] = nlohmann::json::array({u});
+    try {
+      importScan(db, meta(0, 90), &odd);
+      ADD_FAILURE() << u.dump();
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("unmeasured section needs a fraction in (0, 1) and a reason"), std::string::npos)
+          << e.what();
+    }
+  }
   EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 0);
   EXPECT_EQ(count(db, "SELECT count(*) FROM trim_steps"), 0);
   EXPECT_EQ(count(db, "SELECT count(*) FROM campaigns"), 0);

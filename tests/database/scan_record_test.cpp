@@ -72,6 +72,32 @@ TEST(ScanRecord, ReadsBackWhatImportStored) {
   EXPECT_DOUBLE_EQ(r.analysis_params["sensor_sigma_m"].get<double>(), 0.004);
 }
 
+TEST(ScanRecord, SectionsTheAnalysisCouldNotMeasureComeBackWithWhy) {
+  TempDir dir;
+  Database db = openSailDatabase(dir.file("s.sqlite"));
+  ImportMetadata meta;
+  meta.campaign = "Lorient";
+  meta.sail = "J1";
+  auto doc = analysisDoc(10.0, 2);  // measured at 1/3 and 2/3
+  const std::string why = "the section plane at fraction 0.900 leaves 14 % of the chord at the leech uncovered";
+  doc["unmeasured_sections"] = {{{"fraction", 0.9}, {"reason", why}}};
+  const ImportResult imported = importScan(db, meta, &doc, nullptr);
+  const ScanRecord r = loadScanRecord(db, imported.scan_id);
+  EXPECT_EQ(r.sections.sections.size(), 2u);
+  ASSERT_EQ(r.sections.unmeasured.size(), 1u);
+  EXPECT_DOUBLE_EQ(r.sections.unmeasured[0].fraction, 0.9);
+  EXPECT_EQ(r.sections.unmeasured[0].reason, why);
+  // The rest of the diagnostics is stored as it was.
+  Statement s = db.prepare("SELECT diagnostics FROM analyses WHERE id = ?");
+  s.bind(1, imported.analysis_id);
+  ASSERT_TRUE(s.step());
+  EXPECT_EQ(nlohmann::json::parse(s.columnText(0))["points_in"].get<int>(), 50000);
+
+  // An analysis without any keeps an empty list.
+  const auto plain = analysisDoc(10.0);
+  EXPECT_TRUE(loadScanRecord(db, importScan(db, meta, &plain, nullptr).scan_id).sections.unmeasured.empty());
+}
+
 TEST(ScanRecord, ScanWithoutCloudOrAnalysis) {
   TempDir dir;
   Database db = openSailDatabase(dir.file("s.sqlite"));

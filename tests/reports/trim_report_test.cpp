@@ -363,6 +363,35 @@ TEST(TrimReport, SingleScanReport) {
   EXPECT_NE(text.find(std::string(kTest) + " · trim step 2"), std::string::npos);
 }
 
+TEST(TrimReport, ASectionTheAnalysisCouldNotMeasureIsNamedWithWhy) {
+  TempDir dir;
+  const std::string db_path = dir.file("partial.sailshape");
+  int64_t scan_id = 0;
+  {
+    Database db = openSailDatabase(db_path);
+    const SailDesign design = exampleDesign(SailType::Main);
+    const Mesh mesh = generateSailMesh(design);
+    upsertSail(db, {"J2", "jib", "", "", "", ""}, &mesh);
+    const SailSurface surface(design);
+    nlohmann::json doc;
+    doc["sections"] = {flyingSection(surface, 0.25, 0), flyingSection(surface, 0.75, 0)};
+    doc["unmeasured_sections"] = {
+        {{"fraction", 0.5}, {"reason", "the section plane at fraction 0.500 crosses a hole 44 % of the chord wide"}}};
+    ImportMetadata meta;
+    meta.campaign = "Partial";
+    meta.sail = "J2";
+    scan_id = importScan(db, meta, &doc).scan_id;
+  }
+  TrimReportParams p;
+  p.db_path = db_path;
+  p.scan_id = scan_id;
+  p.out_path = dir.file("partial.pdf");
+  writeTrimReport(p);
+  const std::string text = pdfText(p.out_path);
+  EXPECT_NE(text.find("The 50 % section was not measured"), std::string::npos) << text;
+  EXPECT_NE(text.find("crosses a hole 44 %"), std::string::npos) << text;
+}
+
 TEST(TrimReport, BadRequestsThrowAndLeaveAnExistingFileAlone) {
   const std::string keep = fixture().dir.file("keep.pdf");
   { std::ofstream(keep) << "an earlier report"; }
