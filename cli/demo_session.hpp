@@ -17,7 +17,10 @@ struct DemoOptions {
   std::string dir = "sailshape-demo";  // receives sailshape.db, the unit files and the captures
   int steps = 3;                       // trim steps of the test (gennaker tack eased each step)
   int sections = 3;                    // per sail, SPEC §5 fractions k/(N+1)
-  int scan_lines = 250;                // per sweep and unit: sets the turntable speed
+  // Per sweep and unit: sets the turntable speed. 400 lines, 0.25° apart, put 6 or more
+  // cut points within 10-16 % of either end of the upper sections' short chords (at 250,
+  // 0.4° apart, some ends held 5 and their entry or exit could not be read).
+  int scan_lines = 400;
   // Scanner angular step: the finest each model offers at 25 Hz (LMS511 0.1667°, LMS111 0.25°), or 0.5° when coarse.
   bool coarse = false;
   uint64_t seed = 1;                   // emulator noise
