@@ -10,6 +10,7 @@
 #include "cli/commands.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"
+#include "database/scan_record.hpp"
 #include "database/schema.hpp"
 #include "database/table_export.hpp"
 
@@ -279,15 +280,27 @@ void addDbCommand(CLI::App& app) {
     const Table scan = findScans(d, f);
     if (scan.rows.empty()) throw InvalidInput("db show: no scan " + std::to_string(o->scan_id) + " in " + o->db);
     const Table sections = findSections(d, f);
+    // Sections the latest analysis was asked for but could not measure.
+    std::vector<UnmeasuredSection> unmeasured;
+    {
+      Statement a = d.prepare("SELECT max(id) FROM analyses WHERE scan_id = ?");
+      a.bind(1, o->scan_id);
+      if (a.step() && !a.isNull(0)) unmeasured = unmeasuredSections(d, a.columnInt(0));
+    }
     if (o->json) {
       nlohmann::ordered_json j = tableToJson(scan)[0];
       j["sections"] = tableToJson(sections);
+      j["unmeasured_sections"] = nlohmann::ordered_json::array();
+      for (const UnmeasuredSection& u : unmeasured)
+        j["unmeasured_sections"].push_back({{"fraction", u.fraction}, {"reason", u.reason}});
       std::cout << j.dump(2) << "\n";
       return;
     }
     for (size_t c = 0; c < scan.columns.size(); ++c) std::printf("%-15s %s\n", scan.columns[c].c_str(), text(scan.rows[0][c]).c_str());
     std::printf("\n");
     printTable(sections);
+    for (const UnmeasuredSection& u : unmeasured)
+      std::printf("section %.3f not measured: %s\n", u.fraction, u.reason.c_str());
   });
 
   CLI::App* query = db->add_subcommand("query", "Query the reference database; prints a table, CSV or JSON");

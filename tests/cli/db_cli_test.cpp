@@ -94,6 +94,30 @@ TEST_F(DbCli, InitImportQueryExportCheckBackup) {
   EXPECT_EQ(run("db list " + copy + " --csv").out, list.out);
 }
 
+TEST_F(DbCli, ShowNamesTheSectionsTheAnalysisCouldNotMeasure) {
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  nlohmann::json doc = nlohmann::json::parse(readText(analysisJson(9)));
+  doc["sections"].erase(1);  // 0.5 was asked for and not measured
+  const std::string why = "the section plane at fraction 0.500 crosses a hole 44 % of the chord wide (bridged up to 35 %)";
+  doc["unmeasured_sections"] = {{{"fraction", 0.5}, {"reason", why}}};
+  const fs::path file = dir_ / "partial.json";
+  std::ofstream(file) << doc.dump();
+  const Outcome o = run("db import " + db_ + " " + file.string() + " --sail G1");
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_NE(o.out.find("2 sections"), std::string::npos) << o.out;
+
+  Outcome show = run("db show " + db_ + " 1");
+  ASSERT_EQ(show.exit_code, 0) << show.err;
+  EXPECT_NE(show.out.find("section 0.500 not measured: " + why), std::string::npos) << show.out;
+  show = run("db show " + db_ + " 1 --json");
+  ASSERT_EQ(show.exit_code, 0) << show.err;
+  const auto j = nlohmann::json::parse(show.out);
+  EXPECT_EQ(j["sections"].size(), 2u);
+  ASSERT_EQ(j["unmeasured_sections"].size(), 1u);
+  EXPECT_DOUBLE_EQ(j["unmeasured_sections"][0]["fraction"].get<double>(), 0.5);
+  EXPECT_EQ(j["unmeasured_sections"][0]["reason"].get<std::string>(), why);
+}
+
 TEST_F(DbCli, ErrorsAreOneLineAndNonZero) {
   const std::string notes = (dir_ / "notes.db").string();
   std::ofstream(notes) << "not a database, just a long enough line of text to fill a header\n";
