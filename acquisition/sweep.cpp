@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <thread>
 
 #include "acquisition/scan_data.hpp"
@@ -62,6 +63,17 @@ std::vector<Vec3> previewPoints(const UnitConfig& unit, const ScanData& s, doubl
 Vec3 sweepPointPosition(const UnitConfig& unit, double r, double alpha, double beta) {
   return unit.pose * unitPoint(r, alpha, beta, unit.p_m, unit.theta_rad);
 }
+
+namespace {
+
+// A duration as typed: 15, 1.5, 1.25 (not 15.000000).
+std::string shortNumber(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+
+}  // namespace
 
 void validateSweepOptions(const SweepOptions& o) {
   auto need = [](double v, const char* what) {
@@ -124,7 +136,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
       const double left = deadline - hostTimeSeconds();
       if (left <= 0)
         throw ScannerError("[runSweep] " + unit.name + ": the scanner streamed no scan within " +
-                           formatFixed(options.ready_timeout_s, options.ready_timeout_s == std::round(options.ready_timeout_s) ? 0 : 1) +
+                           shortNumber(options.ready_timeout_s) +
                            " s of its start-up (device state " + std::to_string(startup.device_state) +
                            (startup.device_state == 0 ? ", busy" : "") + ")");
       const ScanBatch first = scanner.receiveScans(1, left);

@@ -475,18 +475,34 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
 
       double phi = 0;
       Cut cut;
+      // The cut at rotation `angle` about the chord; false (and f, cut as they were)
+      // when that plane finds no curve spanning the chord.
+      std::string why;
       auto cutAt = [&](double angle) {
-        f.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
-        f.y_hat = f.m.cross(f.c_hat);
-        auto cuts = cutMesh(mesh, f.L, f.m);
-        std::string why;
-        if (!pickCut(cuts, f, p.max_bridged_gap, cut, why))
-          throw AnalysisError("[cutSections] the section plane at fraction " + formatFixed(t, 3) + " " + why);
+        Frame g = f;
+        g.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
+        g.y_hat = g.m.cross(g.c_hat);
+        auto cuts = cutMesh(mesh, g.L, g.m);
+        Cut c;
+        if (!pickCut(cuts, g, p.max_bridged_gap, c, why)) return false;
+        f = g;
+        cut = std::move(c);
+        phi = angle;
+        return true;
       };
-      cutAt(0);
+      if (!cutAt(0)) throw AnalysisError("[cutSections] the section plane at fraction " + formatFixed(t, 3) + " " + why);
       s.converged = true;
       if (p.plane == "normal") {
         s.converged = false;
+        // A tilted plane that loses the curve (it leaves the sail through a hole or an
+        // uncovered end) ends the search at the last plane that held it.
+        auto tiltTo = [&](double angle) {
+          if (cutAt(angle)) return true;
+          result.warnings.push_back("section " + formatFixed(t, 3) + ": the plane tilted " +
+                                    formatFixed(angle * kDeg, 1) + " deg " + why + "; kept at " +
+                                    formatFixed(phi * kDeg, 1) + " deg");
+          return false;
+        };
         for (int it = 0; it < p.max_iterations; ++it) {
           const auto xy = toChordCoords(cut, f);
           const size_t imax = maxDepthIndex(xy, f.chord);
@@ -500,13 +516,12 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
           }
           const double en = e.dot(n);
           if (std::abs(en) < 1e-9) break;
-          phi += std::atan(-f.m.dot(n) / en);
-          if (std::abs(phi) * kDeg > p.max_tilt_deg) {
-            phi = std::copysign(p.max_tilt_deg / kDeg, phi);
-            cutAt(phi);
+          const double next = phi + std::atan(-f.m.dot(n) / en);
+          if (std::abs(next) * kDeg > p.max_tilt_deg) {
+            tiltTo(std::copysign(p.max_tilt_deg / kDeg, next));
             break;
           }
-          cutAt(phi);
+          if (!tiltTo(next)) break;
         }
         if (!s.converged)
           result.warnings.push_back("section " + formatFixed(t, 3) + ": the plane did not reach the surface normal within " +

@@ -61,8 +61,9 @@ struct Section {
   double bridged_pct = 0;             // % of the chord bridged across holes (see max_bridged_gap)
 };
 
-// A section asked for whose plane found no curve spanning the chord (a hole too
-// wide to bridge, an end of the sail not scanned), and why.
+// A section asked for that could not be measured, and why: its plane found no
+// curve spanning the chord (a hole too wide to bridge, an end of the sail not
+// scanned), or it has no chord (a horizontal plane that misses the leech).
 struct UnmeasuredSection {
   double fraction = 0;
   std::string reason;                 // "the section plane at fraction 0.750 leaves 14 % of the chord ..."

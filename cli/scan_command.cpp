@@ -49,6 +49,14 @@ void run(const ScanOptions& o) {
       throw InvalidInput("[scan] two units are named '" + u.name + "'; unit names must differ");
     bases.push_back(b);
   }
+  {  // bad waits are refused before anything is written
+    SweepOptions check;
+    check.home_timeout_s = o.home_timeout_s;
+    check.ready_timeout_s = o.ready_timeout_s;
+    validateSweepOptions(check);
+    if (!(o.sync_timeout_s > 0))
+      throw InvalidInput("[scan] --sync-timeout must be > 0 (got " + formatFixed(o.sync_timeout_s, 3) + ")");
+  }
   fs::create_directories(o.out);
   // Never overwrite a stored scan.
   for (const std::string& b : bases)

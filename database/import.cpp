@@ -58,7 +58,7 @@ int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, 
         throw InvalidInput(std::string("[") + function +
                            "] an unmeasured section needs a fraction in (0, 1) and a reason (got " + x.dump() + ")");
     }
-    nlohmann::json diagnostics = doc.value("diagnostics", nlohmann::json::object());
+    nlohmann::json diagnostics = doc.value("diagnostics", nlohmann::json::object());  // an object: checked by the callers
     diagnostics["unmeasured_sections"] = u;
     a.bind(5, diagnostics.dump());
   } else {
@@ -129,6 +129,9 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
   if (!analysis && !cloud) throw InvalidInput("[importScan] nothing to import: neither an analysis nor a cloud");
   if (analysis && !hasSectionsArray(*analysis))
     throw InvalidInput("[importScan] the analysis document has no \"sections\" array (is it `sailshape analyze --json` output?)");
+  if (analysis && analysis->contains("diagnostics") && !(*analysis)["diagnostics"].is_object())
+    throw InvalidInput("[importScan] the analysis document's diagnostics must be an object (got " +
+                       std::string((*analysis)["diagnostics"].type_name()) + ")");
   for (const auto& [name, value] : meta.controls)
     if (name.empty() || !std::isfinite(value))
       throw InvalidInput("[importScan] control setting \"" + name + "\" needs a name and a finite value (got " +
@@ -234,6 +237,9 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
 int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis, const std::string& software_version) {
   if (!hasSectionsArray(analysis))
     throw InvalidInput("[addAnalysis] the analysis document has no \"sections\" array");
+  if (analysis.contains("diagnostics") && !analysis["diagnostics"].is_object())
+    throw InvalidInput("[addAnalysis] the analysis document's diagnostics must be an object (got " +
+                       std::string(analysis["diagnostics"].type_name()) + ")");
   Transaction tx(db);
   Statement s = db.prepare("SELECT 1 FROM scans WHERE id = ?");
   s.bind(1, scan_id);

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "analysis/errors.hpp"
+#include "database/scan_record.hpp"
 
 namespace sailshape {
 namespace {
@@ -153,7 +154,24 @@ Table parameterEvolution(Database& db, const std::string& test, const std::strin
       " ORDER BY abs(y.fraction - ?) LIMIT 1)" + w.sql + " ORDER BY t.step_order, s.id");
   s.bind(1, fraction);
   bindAll(s, w.args, 2);
-  return collect(s);
+  Table t = collect(s);
+  // A step whose analysis was asked for a section nearer `fraction` than the one
+  // found, and could not measure it, has no value there: the nearest measured one
+  // belongs to another height.
+  for (auto& row : t.rows) {
+    const auto* scan_id = std::get_if<int64_t>(&row[2]);
+    const auto* found = std::get_if<double>(&row[4]);
+    if (!scan_id || !found) continue;
+    Statement a = db.prepare("SELECT max(id) FROM analyses WHERE scan_id = ?");
+    a.bind(1, *scan_id);
+    if (!a.step() || a.isNull(0)) continue;
+    for (const UnmeasuredSection& u : unmeasuredSections(db, a.columnInt(0)))
+      if (std::abs(u.fraction - fraction) < std::abs(*found - fraction)) {
+        row[4] = row[5] = row[6] = std::monostate{};
+        break;
+      }
+  }
+  return t;
 }
 
 Table compareSails(Database& db, const std::string& sail_a, const std::string& sail_b, double awa_deg,

@@ -41,7 +41,9 @@ const std::vector<std::string>& sectionParameterNames();
 
 // `parameter` (e.g. camber_pct) at the section nearest `fraction` over the trim
 // steps of `test`, in step order: step, awa_deg, scan_id, fraction, value,
-// uncertainty, controls. Throws InvalidInput for an unknown parameter.
+// uncertainty, controls. A step whose analysis left a nearer section unmeasured
+// has NULL fraction, value and uncertainty. Throws InvalidInput for an unknown
+// parameter.
 Table parameterEvolution(Database& db, const std::string& test, const std::string& parameter, double fraction,
                          const ScanFilter& filter = {});
 

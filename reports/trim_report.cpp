@@ -254,11 +254,20 @@ void coverPage(PdfDocument& pdf, Pages& pages, const TrimReportData& r, bool cre
   pdf.text(kMargin + 8, y + 15, crew ? "How the sail flew" : "Largest differences from the design", 12, true, kNavy);
   y += 40;
   const std::string which = d.steps.size() > 1 ? " (" + stepLabel(d, d.steps.back()) + ")" : "";
-  if (r.summary.within_design) {
+  // Sections the last step's analysis could not measure are named: "every section
+  // flew within ..." must not hide them.
+  std::vector<std::string> missing;
+  for (const UnmeasuredSection& u : d.steps.back().unmeasured)
+    missing.push_back(fmt("The %.0f %% section was not measured", 100 * u.fraction) + " (" + u.reason + ").");
+  if (r.summary.within_design && missing.empty()) {
     y = pdf.paragraph(kMargin + 8, y, w - 2 * kMargin - 16,
                       "Every section flew within the report's thresholds of its design" + which + ".", 11);
   } else {
-    for (const std::string& s : r.summary.sentences) {
+    std::vector<std::string> lines = r.summary.sentences;
+    if (r.summary.within_design)
+      lines.push_back("Every measured section flew within the report's thresholds of its design.");
+    lines.insert(lines.end(), missing.begin(), missing.end());
+    for (const std::string& s : lines) {
       pdf.disc(kMargin + 10, y - 4, 2, kFlyingRed);
       y = pdf.paragraph(kMargin + 20, y, w - 2 * kMargin - 28, s, 11) + 4;
     }
@@ -759,6 +768,14 @@ TrimReportData prepareTrimReport(const TrimReportParams& p, const Progress& prog
       for (const Section& ds : r.design_sections.sections)
         if (std::abs(ds.fraction - fs.fraction) < 1e-9) cs.design = ds.value, cs.design_u = ds.uncertainty;
       c.sections.push_back(cs);
+    }
+    if (step.sections.size() < 2) {
+      std::string gone;
+      for (const UnmeasuredSection& u : step.unmeasured) gone += (gone.empty() ? "" : ", ") + fmt("%.0f %%", 100 * u.fraction);
+      throw InvalidInput("[writeTrimReport] scan " + std::to_string(step.scan_id) + " has " +
+                         std::to_string(step.sections.size()) + " measured section" +
+                         (gone.empty() ? "" : " (not measured: " + gone + ")") +
+                         "; its flying surface needs at least two");
     }
     c.flying_surface = loftSections(step.sections);
     c.deviation_m = signedDistances(distance, c.flying_surface.vertices);

@@ -45,6 +45,9 @@ std::vector<SectionRow> sectionRows(const SectionAnalysis& flying, const std::ve
       if (std::abs(d.fraction - s.fraction) <= 1e-6) {
         r.design = d.design;
         r.delta = d.delta;
+        // twist_rel as the comparison took it (from the lowest section both sides
+        // measured), so that flying − design is the Δ shown beside them.
+        r.flying.twist_rel_deg = d.flying.twist_rel_deg;
       }
     rows.push_back(r);
   }

@@ -162,6 +162,8 @@ TEST(AcquisitionCli, AScannerStillSpinningUpPastTheReadyTimeoutIsOneErrorAndNoSc
   r = runSailshape(d, scan("out2") + " --ready-timeout 0");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("ready_timeout_s must be > 0"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(d / "out2")) << "refused before anything is written";
 }
 
 TEST(AcquisitionCli, ErrorsAreOneLine) {

@@ -187,7 +187,7 @@ TEST_F(Cli, SimulatedMainIsMeasuredWithinHalfAPercentOfCamber) {
       EXPECT_TRUE(s[key].is_number()) << key << " = " << s[key];
       EXPECT_TRUE(s["uncertainty"][key].is_number()) << key << " = " << s["uncertainty"][key];
     }
-    // An end angle needs 4 cut points near its end (10 % of the chord, widened to 20 % on a
+    // An end angle needs 6 cut points near its end (10 % of the chord, widened to 20 % on a
     // sparse section); at this density (~3 cm spacing) a short upper chord may not have them.
     // Then it is null, with a warning.
     for (const char* key : {"entry_deg", "exit_deg"}) {

@@ -150,6 +150,13 @@ TEST(Import, BadInputThrowsAndStoresNothing) {
           << e.what();
     }
   }
+  nlohmann::json odd = analysisDoc(8.0);
+  odd["unmeasured_sections"] = {{{"fraction", 0.5}, {"reason", "x"}}};
+  odd["diagnostics"] = "none";
+  EXPECT_THROW(importScan(db, meta(0, 90), &odd), InvalidInput);
+  odd["diagnostics"] = nlohmann::json::object();
+  odd["unmeasured_sections"] = "0.5";
+  EXPECT_THROW(importScan(db, meta(0, 90), &odd), InvalidInput);
   EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 0);
   EXPECT_EQ(count(db, "SELECT count(*) FROM trim_steps"), 0);
   EXPECT_EQ(count(db, "SELECT count(*) FROM campaigns"), 0);

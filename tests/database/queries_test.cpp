@@ -141,6 +141,24 @@ TEST_F(Queries, ParameterEvolutionOverTheTrimSteps) {
     EXPECT_DOUBLE_EQ(num(t.rows[step][col(t, "uncertainty")]), 0.2);
   }
   EXPECT_THROW(parameterEvolution(*db_, "t1", "camber; DROP TABLE scans", 0.5), InvalidInput);
+
+  // A step that could not measure its 0.5 section has no value there, not its 0.25 or 0.75 one.
+  ImportMetadata m;
+  m.campaign = "Lorient";
+  m.sail = "Gen-A";
+  m.test = "t1";
+  m.trim_step = 4;
+  nlohmann::json doc = analysisDoc(12.0);
+  doc["sections"].erase(1);
+  doc["unmeasured_sections"] = {{{"fraction", 0.5}, {"reason", "crosses a hole"}}};
+  importScan(*db_, m, &doc);
+  const Table u = parameterEvolution(*db_, "t1", "camber_pct", 0.5);
+  ASSERT_EQ(u.rows.size(), 5u);
+  EXPECT_DOUBLE_EQ(num(u.rows[3][col(u, "value")]), 12.0);
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(u.rows[4][col(u, "value")]));
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(u.rows[4][col(u, "fraction")]));
+  // Nearer its measured 0.75 than the unmeasured 0.5: that section's value stands.
+  EXPECT_DOUBLE_EQ(num(parameterEvolution(*db_, "t1", "camber_pct", 0.7).rows[4][col(u, "value")]), 14.0);
   EXPECT_THROW(parameterEvolution(*db_, "t1", "camber_pct", 1.0), InvalidInput);
 }
 

@@ -390,6 +390,36 @@ TEST(TrimReport, ASectionTheAnalysisCouldNotMeasureIsNamedWithWhy) {
   const std::string text = pdfText(p.out_path);
   EXPECT_NE(text.find("The 50 % section was not measured"), std::string::npos) << text;
   EXPECT_NE(text.find("crosses a hole 44 %"), std::string::npos) << text;
+  // Named on the summary too (a bullet there, a note under the section table).
+  size_t named = 0;
+  for (size_t at = text.find("section was not measured"); at != std::string::npos;
+       at = text.find("section was not measured", at + 1))
+    ++named;
+  EXPECT_EQ(named, 2u) << text;
+  EXPECT_EQ(text.find("Every section flew within"), std::string::npos) << text;
+
+  // One measured section makes no flying surface: one error naming the scan and what is missing.
+  {
+    Database db = openSailDatabase(db_path);
+    const SailSurface surface(exampleDesign(SailType::Main));
+    nlohmann::json doc;
+    doc["sections"] = {flyingSection(surface, 0.5, 0)};
+    doc["unmeasured_sections"] = {{{"fraction", 0.25}, {"reason", "leaves 14 % of the chord at the leech uncovered"}},
+                                  {{"fraction", 0.75}, {"reason", "crosses a hole"}}};
+    ImportMetadata meta;
+    meta.campaign = "Partial";
+    meta.sail = "J2";
+    p.scan_id = importScan(db, meta, &doc).scan_id;
+  }
+  p.out_path = dir.file("one.pdf");
+  try {
+    writeTrimReport(p);
+    ADD_FAILURE() << "a report of one section";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("has 1 measured section (not measured: 25 %, 75 %)"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(p.out_path));
 }
 
 TEST(TrimReport, BadRequestsThrowAndLeaveAnExistingFileAlone) {
