@@ -39,7 +39,15 @@ bool plyHasFaces(const std::string& path) {
   return false;
 }
 
-void printTable(const CompareOptions& o, const DesignImport& design, const DesignComparison& c, const std::string& what) {
+// A section asked of both sides that one of them could not measure: it has no delta.
+struct MissingSection {
+  double fraction;
+  std::string side;  // "design" or "flying"
+  std::string reason;
+};
+
+void printTable(const CompareOptions& o, const DesignImport& design, const DesignComparison& c, const std::string& what,
+                const std::vector<MissingSection>& missing) {
   std::printf("Design %s (%s, %s, %s axes)\nFlying %s\n", o.design.c_str(), design.format.c_str(), design.unit.c_str(),
               design.axes.c_str(), o.flying.c_str());
   const DistanceStats& s = c.stats;
@@ -65,6 +73,8 @@ void printTable(const CompareOptions& o, const DesignImport& design, const Desig
     cell(d.design.exit_deg, d.flying.exit_deg, d.delta.exit_deg, 1);
     std::printf("\n");
   }
+  for (const MissingSection& m : missing)
+    std::printf("%5.0f%% not measured on the %s: %s\n", 100 * m.fraction, m.side.c_str(), m.reason.c_str());
   if (!c.warnings.empty()) {
     std::printf("\nWarnings:\n");
     for (const auto& w : c.warnings) std::printf("  %s\n", w.c_str());
@@ -121,6 +131,11 @@ void run(const CompareOptions& o) {
   DesignComparison c = compareWithDesign(design.mesh, design_sections.sections, points, flying_sections, bar.progress());
   bar.finish();
   c.warnings.insert(c.warnings.begin(), warnings.begin(), warnings.end());
+  for (const std::string& w : design_sections.sections.warnings) c.warnings.push_back("design: " + w);
+  std::vector<MissingSection> missing;
+  for (const UnmeasuredSection& u : design_sections.sections.unmeasured) missing.push_back({u.fraction, "design", u.reason});
+  for (const UnmeasuredSection& u : flying_sections.unmeasured) missing.push_back({u.fraction, "flying", u.reason});
+  std::sort(missing.begin(), missing.end(), [](const auto& a, const auto& b) { return a.fraction < b.fraction; });
 
   if (!o.distances_out.empty()) {
     Cloud out;
@@ -131,7 +146,7 @@ void run(const CompareOptions& o) {
     if (!o.quiet) std::fprintf(stderr, "wrote %s (intensity = signed distance, mm)\n", o.distances_out.c_str());
   }
   if (o.json_out.empty()) {
-    printTable(o, design, c, what);
+    printTable(o, design, c, what, missing);
     return;
   }
   nlohmann::json doc;
@@ -149,6 +164,9 @@ void run(const CompareOptions& o) {
                                {"design", sectionParametersToJson(d.design)},
                                {"flying", sectionParametersToJson(d.flying)},
                                {"delta", sectionParametersToJson(d.delta)}});
+  doc["unmeasured_sections"] = nlohmann::json::array();
+  for (const MissingSection& m : missing)
+    doc["unmeasured_sections"].push_back({{"fraction", m.fraction}, {"side", m.side}, {"reason", m.reason}});
   doc["warnings"] = c.warnings;
   writeJsonFile(o.json_out, doc);
   if (!o.quiet) std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <Eigen/Core>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -295,6 +296,47 @@ TEST_F(Cli, CompareADeeperFlyingMeshWithItsDesign) {
   EXPECT_EQ(r.exit_code, 1);
   ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
   EXPECT_NE(r.err.find("nothing.xyz"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, CompareNamesASectionTheFlyingScanCouldNotMeasure) {
+  ASSERT_EQ(sailshape("design new --type main --out " + path("design.ply")).exit_code, 0);
+  ASSERT_EQ(sailshape("simulate --type main --points 40000 --out " + path("scan.xyz") + " --truth " + path("t.json")).exit_code, 0);
+  // A hole half the mid section's chord wide, centred on it: too wide to bridge.
+  ASSERT_EQ(sailshape("analyze " + path("scan.xyz") + " -q --json " + path("a.json")).exit_code, 0);
+  const json mid = json::parse(readText(path("a.json")))["sections"][1];
+  Eigen::Vector3d luff, leech;
+  for (int i = 0; i < 3; ++i) {
+    luff[i] = mid["luff_point"][i].get<double>();
+    leech[i] = mid["leech_point"][i].get<double>();
+  }
+  const Eigen::Vector3d centre = 0.5 * (luff + leech);
+  const double radius = 0.25 * (leech - luff).norm();
+  {
+    std::ifstream in(path("scan.xyz"));
+    std::ofstream out(path("holed.xyz"));
+    for (std::string line; std::getline(in, line);) {
+      Eigen::Vector3d p;
+      if (line.empty() || line[0] == '#' || !(std::istringstream(line) >> p.x() >> p.y() >> p.z()) ||
+          (p - centre).norm() > radius)
+        out << line << "\n";
+    }
+  }
+  Outcome r = sailshape("compare --design " + path("design.ply") + " --flying " + path("holed.xyz") + " -q --json " +
+                        path("cmp.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json doc = json::parse(readText(path("cmp.json")));
+  ASSERT_EQ(doc["sections"].size(), 2u);
+  EXPECT_DOUBLE_EQ(doc["sections"][0]["fraction"].get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(doc["sections"][1]["fraction"].get<double>(), 0.75);
+  ASSERT_EQ(doc["unmeasured_sections"].size(), 1u);
+  EXPECT_DOUBLE_EQ(doc["unmeasured_sections"][0]["fraction"].get<double>(), 0.5);
+  EXPECT_EQ(doc["unmeasured_sections"][0]["side"], "flying");
+  EXPECT_NE(doc["unmeasured_sections"][0]["reason"].get<std::string>().find("crosses a hole"), std::string::npos);
+  r = sailshape("compare --design " + path("design.ply") + " --flying " + path("holed.xyz") + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("50% not measured on the flying: the section plane at fraction 0.500 crosses a hole"),
+            std::string::npos)
+      << r.out;
 }
 
 }  // namespace
