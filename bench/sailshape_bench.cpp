@@ -214,10 +214,14 @@ void BM_Ours_WholeAnalysis(benchmark::State& state) {
   const Cloud& c = sail(static_cast<size_t>(state.range(0)));
   const SailSurface truth(exampleDesign(SailType::Main));
   double camber = 0, draft = 0, twist = 0, ends = 0;
+  size_t unmeasured = 0;  // sections or end angles the errors above could not include
   std::map<std::string, double> stage_ms;  // summed over iterations
   for (auto _ : state) {
     const SailAnalysis a = analyzeSail(c);
     for (const StageReport& r : a.stages) stage_ms[r.name] += 1e3 * r.seconds;
+    unmeasured += a.sections.unmeasured.size();
+    for (const Section& s : a.sections.sections)
+      unmeasured += !std::isfinite(s.value.entry_deg) + !std::isfinite(s.value.exit_deg);
     for (const Section& s : a.sections.sections) {
       const KnownSection k = truth.section(s.fraction);
       camber = std::max(camber, std::abs(s.value.camber_pct - k.camber_pct));
@@ -230,6 +234,7 @@ void BM_Ours_WholeAnalysis(benchmark::State& state) {
   state.counters["err_draft_pct"] = draft;
   state.counters["err_twist_deg"] = twist;
   state.counters["err_entry_exit_deg"] = ends;
+  state.counters["unmeasured"] = static_cast<double>(unmeasured);
   // Each stage's wall time, ms per run ("statistical outliers" -> "ms_statistical_outliers").
   for (const auto& [name, ms] : stage_ms) {
     std::string key = "ms_" + name;

@@ -57,6 +57,12 @@ int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, 
       if (!fraction || *fraction <= 0 || *fraction >= 1 || !x.contains("reason") || !x["reason"].is_string())
         throw InvalidInput(std::string("[") + function +
                            "] an unmeasured section needs a fraction in (0, 1) and a reason (got " + x.dump() + ")");
+      for (const nlohmann::json& j : doc["sections"]) {
+        const auto measured = number(j, "fraction");
+        if (measured && std::abs(*measured - *fraction) < 1e-9)
+          throw InvalidInput(std::string("[") + function + "] section " + std::to_string(*fraction) +
+                             " is both measured and unmeasured");
+      }
     }
     nlohmann::json diagnostics = doc.value("diagnostics", nlohmann::json::object());  // an object: checked by the callers
     diagnostics["unmeasured_sections"] = u;

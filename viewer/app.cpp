@@ -859,19 +859,23 @@ void App::drawTrimComparison() {
       if (ImGui::Selectable(fieldInfo(f).name, f == plots_.compare_field)) plots_.compare_field = f;
     ImGui::EndCombo();
   }
-  const auto& base = load_.scene->sections.sections;
   struct Row {
     const ScanScene* scene;
     ImVec4 colour;
   };
   std::vector<Row> rows{{&*load_.scene, ImVec4(0.86f, 0.13f, 0.10f, 1.0f)}};
   for (const auto& ov : overlayList()) rows.push_back({ov.scene, toVec4(ov.colour)});
+  // A column for every section height any row measured or was asked for (one step
+  // may have left a section unmeasured that another measured).
+  std::vector<const SectionAnalysis*> steps;
+  for (const Row& row : rows) steps.push_back(&row.scene->sections);
+  const std::vector<double> base = sectionColumns(steps);
   const int cols = 3 + static_cast<int>(base.size());
   if (ImGui::BeginTable("trim", cols, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV | ImGuiTableFlags_ScrollX)) {
     ImGui::TableSetupColumn("step");
     ImGui::TableSetupColumn("AWA");
     ImGui::TableSetupColumn("controls");
-    for (const auto& s : base) ImGui::TableSetupColumn(format("f %.2f", s.fraction).c_str());
+    for (double f : base) ImGui::TableSetupColumn(format("f %.2f", f).c_str());
     ImGui::TableHeadersRow();
     const FieldInfo& info = fieldInfo(plots_.compare_field);
     for (const Row& row : rows) {
@@ -884,11 +888,11 @@ void App::drawTrimComparison() {
       ImGui::TableNextColumn();
       const TrimStepEntry* step = browser_.tree.stepOf(r.scan_id);
       ImGui::TextUnformatted(step && !step->controls.empty() ? step->controls.c_str() : "—");
-      for (const auto& s : base) {
+      for (double f : base) {
         ImGui::TableNextColumn();
         const Section* match = nullptr;
         for (const auto& o : row.scene->sections.sections)
-          if (std::abs(o.fraction - s.fraction) < 0.02) match = &o;
+          if (std::abs(o.fraction - f) < 0.02) match = &o;
         ImGui::Text("%s", match ? format(info.format, fieldValue(match->value, plots_.compare_field)).c_str() : "—");
       }
     }

@@ -54,6 +54,19 @@ std::vector<SectionRow> sectionRows(const SectionAnalysis& flying, const std::ve
   return rows;
 }
 
+std::vector<double> sectionColumns(const std::vector<const SectionAnalysis*>& steps) {
+  std::vector<double> all;
+  for (const SectionAnalysis* a : steps) {
+    for (const Section& s : a->sections) all.push_back(s.fraction);
+    for (const UnmeasuredSection& u : a->unmeasured) all.push_back(u.fraction);
+  }
+  std::sort(all.begin(), all.end());
+  std::vector<double> columns;
+  for (double f : all)
+    if (columns.empty() || f - columns.back() >= 0.02) columns.push_back(f);
+  return columns;
+}
+
 PlotSeries parameterVsHeight(const SectionAnalysis& sections, SectionField field, std::string label) {
   std::vector<const Section*> order;
   for (const Section& s : sections.sections) order.push_back(&s);

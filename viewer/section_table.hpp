@@ -32,6 +32,10 @@ struct SectionRow {
 // One row per flying section; design and delta from `deltas` matched by fraction (±1e-6).
 std::vector<SectionRow> sectionRows(const SectionAnalysis& flying, const std::vector<SectionDelta>& deltas = {});
 
+// The trim comparison's columns: every section fraction any of `steps` measured or
+// left unmeasured, ascending, fractions closer than 0.02 taken as one (the first).
+std::vector<double> sectionColumns(const std::vector<const SectionAnalysis*>& steps);
+
 struct PlotSeries {
   std::string label;
   std::vector<double> value;     // the parameter, in its unit (NaN: not measurable, skipped)

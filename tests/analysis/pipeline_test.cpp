@@ -438,6 +438,11 @@ TEST(Pipeline, WhenNoSectionCanBeMeasuredTheAnalysisIsOneErrorNamingIt) {
   p.sections.fractions = {0.5};
   expectThrowWith<AnalysisError>([&] { analyzeSail(holed, p); },
                                  {"[cutSections]", "fraction 0.500", "crosses a hole", "bridged up to 35 %"});
+  // Two asked, both through the hole: one error naming each.
+  p.sections.fractions = {0.49, 0.51};
+  expectThrowWith<AnalysisError>([&] { analyzeSail(holed, p); },
+                                 {"[cutSections] no section could be measured: ", "fraction 0.490 crosses a hole",
+                                  "; the section plane at fraction 0.510 crosses a hole"});
 }
 
 TEST(Pipeline, ABadSectionParameterIsReportedBeforeAnyWork) {

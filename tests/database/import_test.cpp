@@ -157,6 +157,13 @@ TEST(Import, BadInputThrowsAndStoresNothing) {
   odd["diagnostics"] = nlohmann::json::object();
   odd["unmeasured_sections"] = "0.5";
   EXPECT_THROW(importScan(db, meta(0, 90), &odd), InvalidInput);
+  odd["unmeasured_sections"] = {{{"fraction", 0.5}, {"reason", "x"}}};  // analysisDoc measured 0.5
+  try {
+    importScan(db, meta(0, 90), &odd);
+    ADD_FAILURE() << "0.5 both measured and not";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("is both measured and unmeasured"), std::string::npos) << e.what();
+  }
   EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 0);
   EXPECT_EQ(count(db, "SELECT count(*) FROM trim_steps"), 0);
   EXPECT_EQ(count(db, "SELECT count(*) FROM campaigns"), 0);

@@ -37,6 +37,21 @@ TEST(SectionTable, RowsPairFlyingWithDesignByFraction) {
   EXPECT_TRUE(sectionRows(SectionAnalysis{}).empty());
 }
 
+TEST(SectionTable, TrimComparisonColumnsCoverEveryStepsSections) {
+  // The loaded step left 0.5 unmeasured; an overlaid step measured it, and 0.76 beside 0.75.
+  SectionAnalysis loaded, overlay;
+  loaded.sections = {section(0.25, 3.0, 12.0), section(0.75, 9.0, 11.0)};
+  loaded.unmeasured = {{0.5, "crosses a hole"}};
+  overlay.sections = {section(0.5, 6.0, 13.0), section(0.76, 9.1, 11.5), section(0.9, 10.0, 9.0)};
+  const std::vector<double> columns = sectionColumns({&loaded, &overlay});
+  ASSERT_EQ(columns.size(), 4u);
+  EXPECT_DOUBLE_EQ(columns[0], 0.25);
+  EXPECT_DOUBLE_EQ(columns[1], 0.5);
+  EXPECT_DOUBLE_EQ(columns[2], 0.75);
+  EXPECT_DOUBLE_EQ(columns[3], 0.9);
+  EXPECT_TRUE(sectionColumns({}).empty());
+}
+
 TEST(SectionTable, SeriesAreSortedByHeight) {
   SectionAnalysis a;
   a.sections = {section(0.75, 9.0, 11.0), section(0.25, 3.0, 12.0)};
