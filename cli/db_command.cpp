@@ -281,12 +281,9 @@ void addDbCommand(CLI::App& app) {
     if (scan.rows.empty()) throw InvalidInput("db show: no scan " + std::to_string(o->scan_id) + " in " + o->db);
     const Table sections = findSections(d, f);
     // Sections the latest analysis was asked for but could not measure.
-    std::vector<UnmeasuredSection> unmeasured;
-    {
-      Statement a = d.prepare("SELECT max(id) FROM analyses WHERE scan_id = ?");
-      a.bind(1, o->scan_id);
-      if (a.step() && !a.isNull(0)) unmeasured = unmeasuredSections(d, a.columnInt(0));
-    }
+    const int64_t analysis_id = latestAnalysisId(d, o->scan_id);
+    const std::vector<UnmeasuredSection> unmeasured =
+        analysis_id == 0 ? std::vector<UnmeasuredSection>{} : unmeasuredSections(d, analysis_id);
     if (o->json) {
       nlohmann::ordered_json j = tableToJson(scan)[0];
       j["sections"] = tableToJson(sections);

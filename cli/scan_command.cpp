@@ -49,14 +49,14 @@ void run(const ScanOptions& o) {
       throw InvalidInput("[scan] two units are named '" + u.name + "'; unit names must differ");
     bases.push_back(b);
   }
-  {  // bad waits are refused before anything is written
-    SweepOptions check;
-    check.home_timeout_s = o.home_timeout_s;
-    check.ready_timeout_s = o.ready_timeout_s;
-    validateSweepOptions(check);
-    if (!(o.sync_timeout_s > 0))
-      throw InvalidInput("[scan] --sync-timeout must be > 0 (got " + formatFixed(o.sync_timeout_s, 3) + ")");
-  }
+  SweepOptions so;
+  so.home = !o.no_home;
+  so.home_timeout_s = o.home_timeout_s;
+  so.ready_timeout_s = o.ready_timeout_s;
+  // Bad waits are refused before anything is written.
+  validateSweepOptions(so);
+  if (!(o.sync_timeout_s > 0))
+    throw InvalidInput("[scan] --sync-timeout must be > 0 (got " + formatFixed(o.sync_timeout_s, 3) + ")");
   fs::create_directories(o.out);
   // Never overwrite a stored scan.
   for (const std::string& b : bases)
@@ -66,10 +66,6 @@ void run(const ScanOptions& o) {
   if (fs::exists(fs::path(o.out) / "scan.json"))
     throw FileError("[scan] " + (fs::path(o.out) / "scan.json").string() + " exists already; choose another --out");
 
-  SweepOptions so;
-  so.home = !o.no_home;
-  so.home_timeout_s = o.home_timeout_s;
-  so.ready_timeout_s = o.ready_timeout_s;
   std::vector<Sweep> sweeps(units.size());
   std::vector<std::string> errors(units.size());
   double spread = 0;

@@ -162,10 +162,9 @@ Table parameterEvolution(Database& db, const std::string& test, const std::strin
     const auto* scan_id = std::get_if<int64_t>(&row[2]);
     const auto* found = std::get_if<double>(&row[4]);
     if (!scan_id || !found) continue;
-    Statement a = db.prepare("SELECT max(id) FROM analyses WHERE scan_id = ?");
-    a.bind(1, *scan_id);
-    if (!a.step() || a.isNull(0)) continue;
-    for (const UnmeasuredSection& u : unmeasuredSections(db, a.columnInt(0)))
+    const int64_t analysis_id = latestAnalysisId(db, *scan_id);
+    if (analysis_id == 0) continue;
+    for (const UnmeasuredSection& u : unmeasuredSections(db, analysis_id))
       if (std::abs(u.fraction - fraction) < std::abs(*found - fraction)) {
         row[4] = row[5] = row[6] = std::monostate{};
         break;

@@ -83,6 +83,12 @@ ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
   return r;
 }
 
+int64_t latestAnalysisId(Database& db, int64_t scan_id) {
+  Statement a = db.prepare("SELECT max(id) FROM analyses WHERE scan_id = ?");
+  a.bind(1, scan_id);
+  return a.step() && !a.isNull(0) ? a.columnInt(0) : 0;
+}
+
 std::vector<UnmeasuredSection> unmeasuredSections(Database& db, int64_t analysis_id) {
   Statement s = db.prepare("SELECT diagnostics FROM analyses WHERE id = ?");
   s.bind(1, analysis_id);

@@ -31,6 +31,9 @@ struct ScanRecord {
   std::optional<Eigen::Matrix4d> registration;  // the latest scanner-to-boat transform, when registered
 };
 
+// The id of scan `scan_id`'s latest analysis; 0 when it has none.
+int64_t latestAnalysisId(Database& db, int64_t scan_id);
+
 // The sections analysis `analysis_id` was asked for but could not measure, with
 // why (stored in its diagnostics by importScan); empty when there were none.
 std::vector<UnmeasuredSection> unmeasuredSections(Database& db, int64_t analysis_id);
