@@ -421,6 +421,216 @@ void checkSectionParams(const SectionParams& p) {
   sectionFractions(p);
 }
 
+namespace {
+
+// What every section of one sail shares: its outline, the corners' plane and the
+// chord ends' uncertainties.
+struct SectionGeometry {
+  const SailOutline& outline;
+  Vec3 corner_normal;
+  double spacing, sigma_luff, sigma_ends;  // sigma_ends: of the chord vector, per axis
+};
+
+// One section at fraction t, per SPEC §5; warnings about it go to `warnings`.
+// Throws AnalysisError when it cannot be measured (cutSections lists it unmeasured).
+Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const SectionGeometry& g,
+                       std::vector<std::string>& warnings) {
+  const SailOutline& outline = g.outline;
+  const Vec3& corner_normal = g.corner_normal;
+  const double spacing = g.spacing, sigma_luff = g.sigma_luff, sigma_ends = g.sigma_ends;
+  Section s;
+  s.fraction = t;
+  Frame f;
+  f.L = pointAtFraction(outline.luff, t);
+  if (p.plane == "horizontal") {
+    // The leech point is where the leech crosses the luff point's height.
+    bool found = false;
+    for (size_t i = 1; i < outline.leech.size() && !found; ++i) {
+      const Vec3 &a = outline.leech[i - 1], &b = outline.leech[i];
+      if ((a.z() - f.L.z()) * (b.z() - f.L.z()) <= 0 && a.z() != b.z()) {
+        f.R = a + (f.L.z() - a.z()) / (b.z() - a.z()) * (b - a);
+        found = true;
+      }
+    }
+    if (!found)
+      throw AnalysisError("[cutSections] horizontal plane at z = " + std::to_string(f.L.z()) +
+                          " m does not cross the leech");
+  } else {
+    f.R = pointAtFraction(outline.leech, t);
+  }
+  f.chord = (f.R - f.L).norm();
+  if (f.chord <= 0) throw AnalysisError("[cutSections] zero chord at fraction " + formatFixed(t, 3));
+  f.c_hat = (f.R - f.L) / f.chord;
+  Vec3 m0 = p.plane == "horizontal" ? Vec3::UnitZ() : f.c_hat.cross(corner_normal);
+  if (m0.norm() < 1e-9) m0 = f.c_hat.cross(Vec3::UnitZ());
+  m0.normalize();
+  const Vec3 e0 = f.c_hat.cross(m0);
+
+  double phi = 0;
+  Cut cut;
+  // The cut at rotation `angle` about the chord; false (and f, cut as they were)
+  // when that plane finds no curve spanning the chord.
+  std::string why;
+  auto cutAt = [&](double angle) {
+    Frame g = f;
+    g.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
+    g.y_hat = g.m.cross(g.c_hat);
+    auto cuts = cutMesh(mesh, g.L, g.m);
+    Cut c;
+    if (!pickCut(cuts, g, p.max_bridged_gap, c, why)) return false;
+    f = g;
+    cut = std::move(c);
+    phi = angle;
+    return true;
+  };
+  if (!cutAt(0)) throw AnalysisError("[cutSections] the section plane at fraction " + formatFixed(t, 3) + " " + why);
+  s.converged = true;
+  if (p.plane == "normal") {
+    s.converged = false;
+    // A tilted plane that loses the curve (it leaves the sail through a hole or an
+    // uncovered end) ends the search at the last plane that held it.
+    auto tiltTo = [&](double angle) {
+      if (cutAt(angle)) return true;
+      warnings.push_back("section " + formatFixed(t, 3) + ": the plane tilted " +
+                                formatFixed(angle * kDeg, 1) + " deg " + why + "; kept at " +
+                                formatFixed(phi * kDeg, 1) + " deg");
+      return false;
+    };
+    for (int it = 0; it < p.max_iterations; ++it) {
+      const auto xy = toChordCoords(cut, f);
+      const size_t imax = maxDepthIndex(xy, f.chord);
+      const uint32_t tri = cut.triangles[std::min(imax, cut.triangles.size() - 1)];
+      const Vec3 n = surfaceNormalNear(mesh, cut.points[imax], p.normal_radius * f.chord, tri);
+      const Vec3 e = f.c_hat.cross(f.m);
+      const double out_of_plane = std::asin(std::clamp(f.m.dot(n), -1.0, 1.0)) * kDeg;
+      if (std::abs(out_of_plane) <= p.normal_tolerance_deg) {
+        s.converged = true;
+        break;
+      }
+      const double en = e.dot(n);
+      if (std::abs(en) < 1e-9) break;
+      const double next = phi + std::atan(-f.m.dot(n) / en);
+      if (std::abs(next) * kDeg > p.max_tilt_deg) {
+        tiltTo(std::copysign(p.max_tilt_deg / kDeg, next));
+        break;
+      }
+      if (!tiltTo(next)) break;
+    }
+    if (!s.converged)
+      warnings.push_back("section " + formatFixed(t, 3) + ": the plane did not reach the surface normal within " +
+                                std::to_string(p.normal_tolerance_deg) + " deg");
+  }
+  s.plane_tilt_deg = phi * kDeg;
+  s.plane_normal = f.m;
+  s.luff_point = f.L;
+  s.leech_point = f.R;
+  const auto xy = toChordCoords(cut, f);
+  s.curve_samples = xy.size();
+  auto bridged = [&](double x) {
+    for (const Bridge& b : cut.bridges)
+      if (x > b.x0 && x < b.x1) return true;
+    return false;
+  };
+  for (const Bridge& b : cut.bridges) s.bridged_pct += 100.0 * (b.x1 - b.x0) / f.chord;
+  if (!cut.bridges.empty())
+    warnings.push_back("section " + formatFixed(t, 3) + ": a hole in the scan, " +
+                              formatFixed(s.bridged_pct, 0) + " % of the chord, is bridged");
+
+  // Maximum depth: refined by a cubic through the points around the deepest one.
+  const size_t imax = maxDepthIndex(xy, f.chord);
+  const double side = xy[imax].y() >= 0 ? 1.0 : -1.0;
+  double depth = std::abs(xy[imax].y()), depth_x = xy[imax].x();
+  double sd_depth = p.sensor_sigma_m, sd_x = spacing;
+  {
+    std::vector<Eigen::Vector2d> win;
+    for (const auto& v : xy)
+      if (std::abs(v.x() - depth_x) <= p.peak_window * f.chord) win.emplace_back(v.x(), side * v.y());
+    Peak peak;
+    if (fitPeak(win, depth_x, p.peak_window * f.chord, peak)) {
+      const double inflate =
+          std::sqrt(correlationInflation(win.size(), 2 * p.peak_window * f.chord, p.noise_correlation_m));
+      depth = peak.depth;
+      depth_x = peak.x;
+      sd_depth = peak.sd_depth * inflate;
+      sd_x = peak.sd_x * inflate;
+      // A bridge under the crest's window carries its own uncertainty into the
+      // depth; a crest inside it could stand anywhere across it.
+      for (const Bridge& b : cut.bridges) {
+        if (b.x1 < depth_x - p.peak_window * f.chord || b.x0 > depth_x + p.peak_window * f.chord) continue;
+        sd_depth = std::hypot(sd_depth, b.sd);
+        if (depth_x > b.x0 && depth_x < b.x1) sd_x = std::hypot(sd_x, (b.x1 - b.x0) / std::sqrt(12.0));
+      }
+    } else {
+      warnings.push_back("section " + formatFixed(t, 3) +
+                                ": no crest in the peak fit; the deepest cut point is used");
+    }
+  }
+  s.max_camber_point = f.L + depth_x * f.c_hat + side * depth * f.y_hat;
+
+  // Entry and exit: quadratic over the first / last end_window of chord, slope at the end.
+  // A sparse section (a small sail, the upper sections of a coarse scan) may hold only
+  // a few cut points there; the window then widens until it holds kMinEndPoints, to at
+  // most twice end_window (a quadratic over 20 % of a sail's mean line leaves its end
+  // slope within about half a degree), with a warning.
+  auto endAngle = [&](bool at_luff, double& sd_deg) {
+    constexpr size_t kMinEndPoints = 6;
+    const char* const which = at_luff ? "entry" : "exit";
+    std::vector<Eigen::Vector2d> win;
+    const double x_end = at_luff ? 0.0 : f.chord;
+    const double widest = std::min(0.5, 2.0 * p.end_window);
+    double window = p.end_window;
+    for (;;) {
+      win.clear();
+      for (const auto& v : xy)  // measured points only: a bridge is no evidence of the end's slope
+        if (std::abs(v.x() - x_end) <= window * f.chord && !bridged(v.x())) win.emplace_back(v.x(), side * v.y());
+      if (win.size() >= kMinEndPoints || window >= widest) break;
+      window = std::min(widest, 1.25 * window);
+    }
+    // Fewer even then: five points leave a quadratic two degrees of freedom, and its
+    // end slope came out up to 10° off on a clean 8,000-point mainsail.
+    const QuadFit q = win.size() >= kMinEndPoints ? fitQuadratic(win, x_end, 0.0) : QuadFit{};
+    if (!q.ok) {
+      sd_deg = std::numeric_limits<double>::quiet_NaN();
+      warnings.push_back("section " + formatFixed(t, 3) + ": too few points for the " + which + " angle (" +
+                                std::to_string(win.size()) + " within " + formatFixed(100 * window, 0) +
+                                " % of the chord)");
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    if (window > p.end_window)
+      warnings.push_back("section " + formatFixed(t, 3) + ": the " + which + " angle is read from " +
+                                std::to_string(win.size()) + " points over " + formatFixed(100 * window, 0) +
+                                " % of the chord (too few within " + formatFixed(100 * p.end_window, 0) + " %)");
+    const double slope = at_luff ? q.c[1] : -q.c[1];
+    const double inflate = correlationInflation(win.size(), window * f.chord, p.noise_correlation_m);
+    sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDeg;
+    return std::atan(slope) * kDeg;
+  };
+
+  SectionParameters& v = s.value;
+  SectionParameters& u = s.uncertainty;
+  v.chord_m = f.chord;
+  v.camber_pct = 100.0 * depth / f.chord;
+  v.draft_pct = 100.0 * depth_x / f.chord;
+  v.twist_deg = twistDeg(f.L, f.R);
+  v.entry_deg = endAngle(true, u.entry_deg);
+  v.exit_deg = endAngle(false, u.exit_deg);
+  const double chord_dir_sd = sigma_ends / f.chord;  // rad
+  const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
+  u.chord_m = sigma_ends;
+  // The chord line moves by about half the ends' uncertainty at the crest.
+  u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.25 * sigma_ends * sigma_ends) / f.chord;
+  u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_luff * sigma_luff) / f.chord;
+  u.twist_deg = chord_xy > 0 ? sigma_ends / chord_xy * kDeg : 180.0;
+  u.entry_deg = std::hypot(u.entry_deg, chord_dir_sd * kDeg);
+  u.exit_deg = std::hypot(u.exit_deg, chord_dir_sd * kDeg);
+
+  std::vector<Vec3> line = cut.points;
+  s.curve = resampleCurve(line, p.curve_points);
+  return s;
+}
+
+}  // namespace
+
 SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const SectionParams& p) {
   checkSectionParams(p);
   if (mesh.empty()) throw InvalidInput("[cutSections] empty mesh");
@@ -439,201 +649,13 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
   const double sigma_fallback = std::sqrt(p.sensor_sigma_m * p.sensor_sigma_m + spacing * spacing / 12.0);
   const double sigma_luff = outline.luff_sigma_m > 0 ? outline.luff_sigma_m : sigma_fallback;
   const double sigma_leech = outline.leech_sigma_m > 0 ? outline.leech_sigma_m : sigma_fallback;
-  const double sigma_ends = std::hypot(sigma_luff, sigma_leech);  // of the chord vector, per axis
+  const SectionGeometry geometry{outline, corner_normal, spacing, sigma_luff, std::hypot(sigma_luff, sigma_leech)};
   SectionAnalysis result;
   for (double t : fractions) {
     // A section whose plane finds no curve across the chord is left unmeasured;
     // the others stand.
     try {
-      Section s;
-      s.fraction = t;
-      Frame f;
-      f.L = pointAtFraction(outline.luff, t);
-      if (p.plane == "horizontal") {
-        // The leech point is where the leech crosses the luff point's height.
-        bool found = false;
-        for (size_t i = 1; i < outline.leech.size() && !found; ++i) {
-          const Vec3 &a = outline.leech[i - 1], &b = outline.leech[i];
-          if ((a.z() - f.L.z()) * (b.z() - f.L.z()) <= 0 && a.z() != b.z()) {
-            f.R = a + (f.L.z() - a.z()) / (b.z() - a.z()) * (b - a);
-            found = true;
-          }
-        }
-        if (!found)
-          throw AnalysisError("[cutSections] horizontal plane at z = " + std::to_string(f.L.z()) +
-                              " m does not cross the leech");
-      } else {
-        f.R = pointAtFraction(outline.leech, t);
-      }
-      f.chord = (f.R - f.L).norm();
-      if (f.chord <= 0) throw AnalysisError("[cutSections] zero chord at fraction " + formatFixed(t, 3));
-      f.c_hat = (f.R - f.L) / f.chord;
-      Vec3 m0 = p.plane == "horizontal" ? Vec3::UnitZ() : f.c_hat.cross(corner_normal);
-      if (m0.norm() < 1e-9) m0 = f.c_hat.cross(Vec3::UnitZ());
-      m0.normalize();
-      const Vec3 e0 = f.c_hat.cross(m0);
-
-      double phi = 0;
-      Cut cut;
-      // The cut at rotation `angle` about the chord; false (and f, cut as they were)
-      // when that plane finds no curve spanning the chord.
-      std::string why;
-      auto cutAt = [&](double angle) {
-        Frame g = f;
-        g.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
-        g.y_hat = g.m.cross(g.c_hat);
-        auto cuts = cutMesh(mesh, g.L, g.m);
-        Cut c;
-        if (!pickCut(cuts, g, p.max_bridged_gap, c, why)) return false;
-        f = g;
-        cut = std::move(c);
-        phi = angle;
-        return true;
-      };
-      if (!cutAt(0)) throw AnalysisError("[cutSections] the section plane at fraction " + formatFixed(t, 3) + " " + why);
-      s.converged = true;
-      if (p.plane == "normal") {
-        s.converged = false;
-        // A tilted plane that loses the curve (it leaves the sail through a hole or an
-        // uncovered end) ends the search at the last plane that held it.
-        auto tiltTo = [&](double angle) {
-          if (cutAt(angle)) return true;
-          result.warnings.push_back("section " + formatFixed(t, 3) + ": the plane tilted " +
-                                    formatFixed(angle * kDeg, 1) + " deg " + why + "; kept at " +
-                                    formatFixed(phi * kDeg, 1) + " deg");
-          return false;
-        };
-        for (int it = 0; it < p.max_iterations; ++it) {
-          const auto xy = toChordCoords(cut, f);
-          const size_t imax = maxDepthIndex(xy, f.chord);
-          const uint32_t tri = cut.triangles[std::min(imax, cut.triangles.size() - 1)];
-          const Vec3 n = surfaceNormalNear(mesh, cut.points[imax], p.normal_radius * f.chord, tri);
-          const Vec3 e = f.c_hat.cross(f.m);
-          const double out_of_plane = std::asin(std::clamp(f.m.dot(n), -1.0, 1.0)) * kDeg;
-          if (std::abs(out_of_plane) <= p.normal_tolerance_deg) {
-            s.converged = true;
-            break;
-          }
-          const double en = e.dot(n);
-          if (std::abs(en) < 1e-9) break;
-          const double next = phi + std::atan(-f.m.dot(n) / en);
-          if (std::abs(next) * kDeg > p.max_tilt_deg) {
-            tiltTo(std::copysign(p.max_tilt_deg / kDeg, next));
-            break;
-          }
-          if (!tiltTo(next)) break;
-        }
-        if (!s.converged)
-          result.warnings.push_back("section " + formatFixed(t, 3) + ": the plane did not reach the surface normal within " +
-                                    std::to_string(p.normal_tolerance_deg) + " deg");
-      }
-      s.plane_tilt_deg = phi * kDeg;
-      s.plane_normal = f.m;
-      s.luff_point = f.L;
-      s.leech_point = f.R;
-      const auto xy = toChordCoords(cut, f);
-      s.curve_samples = xy.size();
-      auto bridged = [&](double x) {
-        for (const Bridge& b : cut.bridges)
-          if (x > b.x0 && x < b.x1) return true;
-        return false;
-      };
-      for (const Bridge& b : cut.bridges) s.bridged_pct += 100.0 * (b.x1 - b.x0) / f.chord;
-      if (!cut.bridges.empty())
-        result.warnings.push_back("section " + formatFixed(t, 3) + ": a hole in the scan, " +
-                                  formatFixed(s.bridged_pct, 0) + " % of the chord, is bridged");
-
-      // Maximum depth: refined by a cubic through the points around the deepest one.
-      const size_t imax = maxDepthIndex(xy, f.chord);
-      const double side = xy[imax].y() >= 0 ? 1.0 : -1.0;
-      double depth = std::abs(xy[imax].y()), depth_x = xy[imax].x();
-      double sd_depth = p.sensor_sigma_m, sd_x = spacing;
-      {
-        std::vector<Eigen::Vector2d> win;
-        for (const auto& v : xy)
-          if (std::abs(v.x() - depth_x) <= p.peak_window * f.chord) win.emplace_back(v.x(), side * v.y());
-        Peak peak;
-        if (fitPeak(win, depth_x, p.peak_window * f.chord, peak)) {
-          const double inflate =
-              std::sqrt(correlationInflation(win.size(), 2 * p.peak_window * f.chord, p.noise_correlation_m));
-          depth = peak.depth;
-          depth_x = peak.x;
-          sd_depth = peak.sd_depth * inflate;
-          sd_x = peak.sd_x * inflate;
-          // A bridge under the crest's window carries its own uncertainty into the
-          // depth; a crest inside it could stand anywhere across it.
-          for (const Bridge& b : cut.bridges) {
-            if (b.x1 < depth_x - p.peak_window * f.chord || b.x0 > depth_x + p.peak_window * f.chord) continue;
-            sd_depth = std::hypot(sd_depth, b.sd);
-            if (depth_x > b.x0 && depth_x < b.x1) sd_x = std::hypot(sd_x, (b.x1 - b.x0) / std::sqrt(12.0));
-          }
-        } else {
-          result.warnings.push_back("section " + formatFixed(t, 3) +
-                                    ": no crest in the peak fit; the deepest cut point is used");
-        }
-      }
-      s.max_camber_point = f.L + depth_x * f.c_hat + side * depth * f.y_hat;
-
-      // Entry and exit: quadratic over the first / last end_window of chord, slope at the end.
-      // A sparse section (a small sail, the upper sections of a coarse scan) may hold only
-      // a few cut points there; the window then widens until it holds kMinEndPoints, to at
-      // most twice end_window (a quadratic over 20 % of a sail's mean line leaves its end
-      // slope within about half a degree), with a warning.
-      auto endAngle = [&](bool at_luff, double& sd_deg) {
-        constexpr size_t kMinEndPoints = 6;
-        const char* const which = at_luff ? "entry" : "exit";
-        std::vector<Eigen::Vector2d> win;
-        const double x_end = at_luff ? 0.0 : f.chord;
-        const double widest = std::min(0.5, 2.0 * p.end_window);
-        double window = p.end_window;
-        for (;;) {
-          win.clear();
-          for (const auto& v : xy)  // measured points only: a bridge is no evidence of the end's slope
-            if (std::abs(v.x() - x_end) <= window * f.chord && !bridged(v.x())) win.emplace_back(v.x(), side * v.y());
-          if (win.size() >= kMinEndPoints || window >= widest) break;
-          window = std::min(widest, 1.25 * window);
-        }
-        // Fewer even then: five points leave a quadratic two degrees of freedom, and its
-        // end slope came out up to 10° off on a clean 8,000-point mainsail.
-        const QuadFit q = win.size() >= kMinEndPoints ? fitQuadratic(win, x_end, 0.0) : QuadFit{};
-        if (!q.ok) {
-          sd_deg = std::numeric_limits<double>::quiet_NaN();
-          result.warnings.push_back("section " + formatFixed(t, 3) + ": too few points for the " + which + " angle (" +
-                                    std::to_string(win.size()) + " within " + formatFixed(100 * window, 0) +
-                                    " % of the chord)");
-          return std::numeric_limits<double>::quiet_NaN();
-        }
-        if (window > p.end_window)
-          result.warnings.push_back("section " + formatFixed(t, 3) + ": the " + which + " angle is read from " +
-                                    std::to_string(win.size()) + " points over " + formatFixed(100 * window, 0) +
-                                    " % of the chord (too few within " + formatFixed(100 * p.end_window, 0) + " %)");
-        const double slope = at_luff ? q.c[1] : -q.c[1];
-        const double inflate = correlationInflation(win.size(), window * f.chord, p.noise_correlation_m);
-        sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDeg;
-        return std::atan(slope) * kDeg;
-      };
-
-      SectionParameters& v = s.value;
-      SectionParameters& u = s.uncertainty;
-      v.chord_m = f.chord;
-      v.camber_pct = 100.0 * depth / f.chord;
-      v.draft_pct = 100.0 * depth_x / f.chord;
-      v.twist_deg = twistDeg(f.L, f.R);
-      v.entry_deg = endAngle(true, u.entry_deg);
-      v.exit_deg = endAngle(false, u.exit_deg);
-      const double chord_dir_sd = sigma_ends / f.chord;  // rad
-      const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
-      u.chord_m = sigma_ends;
-      // The chord line moves by about half the ends' uncertainty at the crest.
-      u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.25 * sigma_ends * sigma_ends) / f.chord;
-      u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_luff * sigma_luff) / f.chord;
-      u.twist_deg = chord_xy > 0 ? sigma_ends / chord_xy * kDeg : 180.0;
-      u.entry_deg = std::hypot(u.entry_deg, chord_dir_sd * kDeg);
-      u.exit_deg = std::hypot(u.exit_deg, chord_dir_sd * kDeg);
-
-      std::vector<Vec3> line = cut.points;
-      s.curve = resampleCurve(line, p.curve_points);
-      result.sections.push_back(std::move(s));
+      result.sections.push_back(measureSection(t, mesh, p, geometry, result.warnings));
     } catch (const AnalysisError& e) {
       std::string why = e.what();
       const std::string prefix = "[cutSections] ";
