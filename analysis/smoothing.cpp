@@ -235,6 +235,8 @@ std::vector<uint32_t> pickAnchors(const std::vector<Vec3>& pts, double cell) {
 // Fewest neighbours a clean cloud brings k down to: a quadratic's six
 // coefficients from a few dozen points.
 constexpr size_t kMinAdaptedK = 40;
+// The sail max_radius_ratio was set on: √ of the 10 m example mainsail's 18 m².
+constexpr double kReferenceSailSize = 4.25;
 
 // The cloud's noise: at up to `samples` points spread through it, the RMS distance
 // of its 24 nearest from the quadratic height field fitted to them over their
@@ -266,6 +268,8 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
                        std::to_string(p.fair_m) + ")");
   if (!(p.anchor_ratio >= 0 && p.anchor_ratio <= 1))
     throw InvalidInput("[smoothMls] anchor_ratio must be in [0, 1] (got " + std::to_string(p.anchor_ratio) + ")");
+  if (!(p.max_radius_ratio >= 0))
+    throw InvalidInput("[smoothMls] max_radius_ratio must be >= 0 (got " + std::to_string(p.max_radius_ratio) + ")");
   if (!(p.reference_density_per_m2 >= 0))
     throw InvalidInput("[smoothMls] reference_density_per_m2 must be >= 0 (got " +
                        std::to_string(p.reference_density_per_m2) + ")");
@@ -290,8 +294,24 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
                                                                std::sqrt(density / p.reference_density_per_m2))));
       radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
     }
+    if (p.adapt_to_noise || p.max_radius_ratio > 0) result.measured_noise_m = measuredNoise(pts, *median_grid);
+    if (p.max_radius_ratio > 0) {
+      const double sail_size = std::sqrt(static_cast<double>(pts.size()) / density);
+      // Noisier for its size than 4 mm on the reference sail, the averaging is worth a
+      // wider patch: the best radius grows as (noise / size)^0.2 (the quadratic's
+      // bias grows as radius⁴, the noise left falls as 1 / radius).
+      const double relative_noise = (result.measured_noise_m / sail_size) / (p.good_m / kReferenceSailSize);
+      const double max_radius = p.max_radius_ratio * std::pow(std::max(1.0, relative_noise), 0.2) * sail_size;
+      if (radius > max_radius) {
+        const size_t fewer = std::max<size_t>(
+            kMinAdaptedK, std::lround(static_cast<double>(k) * (max_radius / radius) * (max_radius / radius)));
+        if (fewer < k) {
+          k = std::min(fewer, pts.size());
+          radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
+        }
+      }
+    }
     if (p.adapt_to_noise) {
-      result.measured_noise_m = measuredNoise(pts, *median_grid);
       const double ratio = result.measured_noise_m / (0.5 * p.good_m);
       if (ratio < 1) {
         const size_t fewer =

@@ -21,6 +21,20 @@ struct SmoothingParams {
   // as √density / k: 4 mm noise at 200,000 points put exit angles 3° and drafts
   // 2 % off. There k grows with √density to hold it. 0: k stays fixed.
   double reference_density_per_m2 = 4000;
+  // Sparser, the k nearest reach so far that the quadratic flattens the sections'
+  // crests: 5,000 points on the 10 m example main (280 points/m²) put 200 of them
+  // within 0.48 m, over half the 0.9 m chord at 3/4 height, and that section's
+  // camber came out 0.45 % low. The radius is held to this fraction of the sail's
+  // size (√ of its area, from the density) by taking fewer neighbours, down to 40:
+  // k ≤ π · ratio² · points, 1.5 % of the sail's points at 0.07. There the bias at
+  // 5,000 points falls to about 0.2 %, 12,000-point clouds keep their end-angle
+  // noise, and denser ones are left alone (0.06 flattens a little less at 5,000
+  // points but adds end-angle noise at 12,000). A cloud noisier for its size than
+  // 4 mm (good_m) on that 18 m² sail gains more from averaging: the limit grows as
+  // (relative noise)^0.2, so a 1:5 wind-tunnel model under 4 mm noise keeps
+  // about the neighbourhood it had without the limit.
+  // 0: no limit.
+  double max_radius_ratio = 0.07;
   // Those neighbourhoods are sized for the sensor's noise (good_m). A cloud whose
   // measured noise (the RMS off quadratics through 24 neighbours) is under half of
   // that needs less averaging and takes a smaller one: k shrinks with √(noise /

@@ -262,7 +262,8 @@ TEST(SmoothMls, TakesMoreNeighboursInADenseCloud) {
   // so k doubles (√4); the median k-th neighbour distance estimates the density
   // to a few per cent (edges pull it down a little).
   const Cloud dense = noisyPlane(64000, kSigma, 3);
-  const SmoothingParams p;
+  SmoothingParams p;
+  p.max_radius_ratio = 0;  // the 8,000-point patch below would meet the size limit (next tests)
   const Smoothing scaled = smoothMls(dense, p);
   EXPECT_NEAR(static_cast<double>(scaled.k_used), 2.0 * p.k_neighbours, 0.15 * 2.0 * p.k_neighbours);
   SmoothingParams fixed = p;
@@ -279,7 +280,8 @@ TEST(SmoothMls, MeasuresTheNoiseAndTakesFewerNeighboursOnACleanCloud) {
   // Off quadratics through 24 neighbours a plane with σ noise leaves σ (the fit's six
   // coefficients are counted); a clean one leaves nothing, and then k falls to 40:
   // there is no noise to average and a wide neighbourhood only adds the bias.
-  const SmoothingParams p;
+  SmoothingParams p;
+  p.max_radius_ratio = 0;  // k = 200 on this patch spans more than the size limit allows
   const Smoothing noisy = smoothMls(noisyPlane(8000, kSigma, 5), p);
   EXPECT_NEAR(noisy.measured_noise_m, kSigma, 0.1 * kSigma);  // 256 samples of 18 degrees of freedom: ±4 %
   EXPECT_EQ(noisy.k_used, static_cast<size_t>(p.k_neighbours));
@@ -292,6 +294,39 @@ TEST(SmoothMls, MeasuresTheNoiseAndTakesFewerNeighboursOnACleanCloud) {
   SmoothingParams fixed = p;
   fixed.adapt_to_noise = false;
   EXPECT_EQ(smoothMls(noisyPlane(8000, 0.0, 5), fixed).k_used, static_cast<size_t>(p.k_neighbours));
+}
+
+TEST(SmoothMls, HoldsTheRadiusToAFractionOfTheSailsSize) {
+  // 8,000 points on the 2 m × 2 m patch: 2,000 points/m², so 200 neighbours span
+  // √(200 / (π · 2000)) = 0.178 m. The limit is 0.07 × √(4 m²) = 0.14 m, widened for
+  // noise: 4 mm on a 2 m patch is 2.1 times the reference's 4 mm on √18 m², so
+  // 0.14 × 2.1^0.2 = 0.163 m. Held there, the fits take π · 2000 · 0.163² ≈ 167
+  // neighbours: π · N · radius² / area (edges thin the density a little, so the
+  // count comes out a few lower).
+  const SmoothingParams p;
+  const Cloud sparse = noisyPlane(8000, kSigma, 4);
+  const Smoothing held = smoothMls(sparse, p);
+  const double relative_noise = (held.measured_noise_m / 2.0) / (p.good_m / std::sqrt(18.0));
+  const double max_radius = p.max_radius_ratio * std::pow(relative_noise, 0.2) * 2.0;
+  const double expected_k = M_PI * 2000 * max_radius * max_radius;
+  EXPECT_NEAR(static_cast<double>(held.k_used), expected_k, 0.08 * expected_k);
+  EXPECT_LT(held.k_used, static_cast<size_t>(p.k_neighbours));
+  // A clean cloud's limit is not widened: 0.14 m, π · 2000 · 0.14² ≈ 123 neighbours
+  // (the noise rule, off here, would take fewer still).
+  SmoothingParams limit_only = p;
+  limit_only.adapt_to_noise = false;
+  const double clean_k = M_PI * 2000 * std::pow(p.max_radius_ratio * 2.0, 2);
+  EXPECT_NEAR(static_cast<double>(smoothMls(noisyPlane(8000, 0.0, 4), limit_only).k_used), clean_k, 0.08 * clean_k);
+  SmoothingParams unlimited = p;
+  unlimited.max_radius_ratio = 0;
+  EXPECT_EQ(smoothMls(sparse, unlimited).k_used, static_cast<size_t>(p.k_neighbours));
+  // A larger limit than the radius leaves k alone; a tiny one stops at 40 neighbours.
+  SmoothingParams wide = p;
+  wide.max_radius_ratio = 0.1;
+  EXPECT_EQ(smoothMls(sparse, wide).k_used, static_cast<size_t>(p.k_neighbours));
+  SmoothingParams tiny = p;
+  tiny.max_radius_ratio = 0.01;
+  EXPECT_EQ(smoothMls(sparse, tiny).k_used, 40u);
 }
 
 TEST(SmoothMls, RejectsBadParametersAndSmallClouds) {
@@ -317,6 +352,9 @@ TEST(SmoothMls, RejectsBadParametersAndSmallClouds) {
   for (double rho : {-1.0, std::nan("")})
     expectInvalidInput([&] { smoothMls(in, with([rho](auto& p) { p.reference_density_per_m2 = rho; })); },
                        {"[smoothMls]", "reference_density_per_m2 must be >= 0"});
+  for (double ratio : {-0.1, std::nan("")})
+    expectInvalidInput([&] { smoothMls(in, with([ratio](auto& p) { p.max_radius_ratio = ratio; })); },
+                       {"[smoothMls]", "max_radius_ratio must be >= 0"});
   // The limits themselves are accepted.
   EXPECT_EQ(smoothMls(in, with([](auto& p) { p.k_neighbours = 6; })).cloud.size(), in.size());
   EXPECT_EQ(smoothMls(noisyPlane(300, kSigma, 8), with([](auto& p) { p.k_neighbours = 256; })).cloud.size(), 300u);
