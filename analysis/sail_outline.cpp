@@ -717,12 +717,21 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   }
   const double w = p.corner_window_m > 0 ? p.corner_window_m : 0.01 * total;
 
-  // Turning angle over arms of length `arm`; at a corner it approaches the exterior angle.
+  // The loop's normal (Newell's: the sum of its edges' cross products, as long as
+  // the area the loop encloses), so that the loop turns anticlockwise about it.
+  Vec3 loop_normal = Vec3::Zero();
+  for (size_t i = 0; i < n; ++i) loop_normal += pts[i].cross(pts[(i + 1) % n]);
+  // Turning angle over arms of length `arm`; at a corner it approaches the exterior
+  // angle. Negative where the loop turns inwards: a sail's corners all bulge out,
+  // and a notch in a sparse edge (a triangle the long-edge limit left out) turns as
+  // sharply the other way; one 9 cm deep in a 5,000-point mainsail's leech turned
+  // 68° and was taken for the tack.
   auto turnAt = [&](size_t i, double arm) {
     const Vec3 a = pts[i] - loopPointAt(pts, cum, total, cum[i] - arm);
     const Vec3 b = loopPointAt(pts, cum, total, cum[i] + arm) - pts[i];
     const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
-    return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
+    const double angle = std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
+    return a.cross(b).dot(loop_normal) >= 0 ? angle : -angle;
   };
   std::vector<double> turn(n);
   for (size_t i = 0; i < n; ++i) turn[i] = turnAt(i, w);
@@ -736,7 +745,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   };
   std::vector<size_t> picked;
   for (size_t i : order) {
-    if (picked.size() == 4) break;
+    if (picked.size() == 4 || turn[i] <= 0) break;
     bool far = true;
     for (size_t j : picked) far = far && arcDist(i, j) >= min_sep;
     if (far) picked.push_back(i);

@@ -25,7 +25,7 @@ struct SailOutline {
   std::vector<Vec3> boundary;         // the outer boundary loop, as found on the mesh
   Vec3 tack = Vec3::Zero(), clew = Vec3::Zero(), head = Vec3::Zero(), peak = Vec3::Zero();
   bool has_peak = false;              // square-top sail: head (luff side) and peak (leech side)
-  std::vector<double> corner_turn_deg;  // turning angle at tack, clew, head (, peak)
+  std::vector<double> corner_turn_deg;  // turning angle at tack, clew, head (, peak), outwards (> 0)
   // Edge polylines, smoothed, from corner to corner: luff tack→head, leech
   // clew→head (clew→peak with a peak), foot tack→clew, top head→peak.
   std::vector<Vec3> luff, leech, foot, top;

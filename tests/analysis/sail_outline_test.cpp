@@ -151,6 +151,30 @@ TEST(SailOutline, EdgesOfRandomlySampledSheetsLieOnTheirTrueEdges) {
   EXPECT_LT(std::sqrt(sum2 / n), 0.0015);
 }
 
+TEST(SailOutline, ANotchCutIntoAnEdgeIsNoCorner) {
+  // A 3 m × 9 m sheet (a square top's shape) with a wedge 25 cm deep and 24 cm wide
+  // cut into its leech halfway up, where no samples fell (as when the long-edge
+  // limit leaves a triangle of a sparse scan out). Its tip turns the loop as
+  // sharply as a corner, but inwards: the four corners stay the sheet's.
+  constexpr double kWidth = 3.0, kHeight = 9.0, kDepth = 0.25, kHalfWidth = 0.12;
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> x(0.0, kWidth), z(0.0, kHeight);
+  Cloud sheet;
+  while (sheet.size() < 40'500) {
+    const Vec3 p(x(rng), 0.0, z(rng));
+    if (p.x() < kDepth * (1.0 - std::abs(p.z() - 0.5 * kHeight) / kHalfWidth)) continue;
+    sheet.points.push_back(p);
+  }
+  const SailOutline o = extractOutline(reconstructSurface(sheet).mesh);
+  ASSERT_TRUE(o.has_peak);
+  // The sampled corners lie within a few spacings (2.6 cm) of the sheet's.
+  EXPECT_LT((o.tack - Vec3(kWidth, 0, 0)).norm(), 0.03);
+  EXPECT_LT((o.clew - Vec3(0, 0, 0)).norm(), 0.03);
+  EXPECT_LT((o.head - Vec3(kWidth, 0, kHeight)).norm(), 0.03);
+  EXPECT_LT((o.peak - Vec3(0, 0, kHeight)).norm(), 0.03);
+  for (double t : o.corner_turn_deg) EXPECT_GT(t, 0.0);
+}
+
 // A mainsail's head whose last samples stand apart: every sample within 12 cm
 // of the head but the one nearest it is gone, and that one is not in the mesh
 // (as when the surface's long-edge trimming leaves a lone tip sample out).
