@@ -617,9 +617,14 @@ Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, cons
   std::vector<uint32_t> idx;
   std::vector<double> d2;
   tree.withinRadius(m.point, reach, idx, d2);
-  if (idx.empty()) return m.point;
   double extreme = -std::numeric_limits<double>::infinity();
   for (uint32_t v : idx) extreme = std::max(extreme, (mesh.vertices[v] - m.point).dot(m.outward));
+  // No sample within reach: the crossing lies far out beyond the sail, as where
+  // two nearly parallel edges meet (a square top whose peak turned too little to
+  // be found as a corner put its head 3 m above the sail). The outermost sample
+  // along the bisector bounds it then.
+  if (idx.empty())
+    for (const Vec3& v : mesh.vertices) extreme = std::max(extreme, (v - m.point).dot(m.outward));
   // A sample the mesh left out (its triangles' edges too long: a lone sample
   // near a narrow tip) still says how far the sail reaches, if it lies inside
   // both edges and on the surface.
@@ -638,6 +643,11 @@ Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, cons
   const double lambda = density * std::tan(std::min(0.5 * m.angle_rad, 1.4));
   const double gap_scale = 1.0 / std::sqrt(lambda);  // typical empty tip length, m
   const double s = m.sigma_along_m;
+  // A crossing many of its σ and of the tip's gaps beyond every sample comes from
+  // corner curves extrapolated far past their data (σ holds at the corner they
+  // were fitted to, not metres out). The samples alone place it then: at the mean
+  // empty gap, 1 / √(π λ), beyond the outermost.
+  if (extreme < -6.0 * (s + gap_scale)) return m.point + (extreme + 1.0 / std::sqrt(kPi * lambda)) * m.outward;
   const double lo = extreme, hi = std::max(extreme, 0.0) + 6.0 * std::max(s, gap_scale);
   constexpr int kSteps = 2000;
   double wsum = 0, xsum = 0;

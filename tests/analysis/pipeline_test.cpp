@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "analysis/analysis_json.hpp"
@@ -337,6 +338,24 @@ TEST(Pipeline, ANotchInASparseLeechIsNotTakenForTheTack) {
   // A twist wrong by a fraction of a degree would still be a right tack: 1° is a
   // 5 cm shift over the upper section's 0.9 m chord.
   for (const Section& s : a.sections.sections) EXPECT_NEAR(s.value.twist_deg, truth.section(s.fraction).twist_deg, 1.0);
+}
+
+TEST(Pipeline, NoCornerLandsFarBeyondTheSamples) {
+  // 5,000 samples on the square top, 7 cm apart: on this seed the rounded-off peak
+  // turns the boundary by 34°, under the 40° a fourth corner needs, and the sail is
+  // taken for a triangle. Its head is then where luff and leech cross, and those
+  // two, nearly parallel, crossed 3 m above the sail; the head was put there. A
+  // corner lies at most a few sample spacings beyond the samples.
+  const SailDesign design = exampleDesign(SailType::SquareTopMain);
+  const Cloud samples = sampleSail(design, scan(5000, 7));
+  const SailAnalysis a = analyzeSail(samples);
+  std::vector<Vec3> corners{a.outline.tack, a.outline.clew, a.outline.head};
+  if (a.outline.has_peak) corners.push_back(a.outline.peak);
+  for (const Vec3& c : corners) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Vec3& p : samples.points) nearest = std::min(nearest, (p - c).norm());
+    EXPECT_LT(nearest, 0.2) << "corner " << c.transpose();
+  }
 }
 
 TEST(Pipeline, SceneWithMastBoomAndDeckIsSegmentedToTheSail) {
