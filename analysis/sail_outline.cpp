@@ -622,9 +622,14 @@ Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, cons
   // No sample within reach: the crossing lies far out beyond the sail, as where
   // two nearly parallel edges meet (a square top whose peak turned too little to
   // be found as a corner put its head 3 m above the sail). The outermost sample
-  // along the bisector bounds it then.
+  // along the bisector, within reach of it sideways, bounds it then.
   if (idx.empty())
-    for (const Vec3& v : mesh.vertices) extreme = std::max(extreme, (v - m.point).dot(m.outward));
+    for (const Vec3& v : mesh.vertices) {
+      const Vec3 d = v - m.point;
+      const double along = d.dot(m.outward);
+      if ((d - along * m.outward).squaredNorm() <= reach * reach) extreme = std::max(extreme, along);
+    }
+  if (!std::isfinite(extreme)) return m.point;
   // A sample the mesh left out (its triangles' edges too long: a lone sample
   // near a narrow tip) still says how far the sail reaches, if it lies inside
   // both edges and on the surface.
@@ -640,7 +645,9 @@ Vec3 placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, cons
       if (inside && on_surface) extreme = std::max(extreme, d.dot(m.outward));
     }
   }
-  const double lambda = density * std::tan(std::min(0.5 * m.angle_rad, 1.4));
+  // (Edges parallel to the last bit still leave a wedge: the half angle is floored
+  // as meetEdges floors it, so that λ > 0.)
+  const double lambda = density * std::tan(std::clamp(0.5 * m.angle_rad, 1e-3, 1.4));
   const double gap_scale = 1.0 / std::sqrt(lambda);  // typical empty tip length, m
   const double s = m.sigma_along_m;
   // A crossing many of its σ and of the tip's gaps beyond every sample comes from
@@ -727,8 +734,8 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   }
   const double w = p.corner_window_m > 0 ? p.corner_window_m : 0.01 * total;
 
-  // The loop's normal (Newell's: the sum of its edges' cross products, as long as
-  // the area the loop encloses), so that the loop turns anticlockwise about it.
+  // The loop's normal (Newell's: the sum of its edges' cross products, twice the
+  // area the loop encloses), so that the loop turns anticlockwise about it.
   Vec3 loop_normal = Vec3::Zero();
   for (size_t i = 0; i < n; ++i) loop_normal += pts[i].cross(pts[(i + 1) % n]);
   // Turning angle over arms of length `arm`; at a corner it approaches the exterior
@@ -789,14 +796,15 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
     throw AnalysisError("[extractOutline] asked for " + std::to_string(count) + " corners, found " +
                         std::to_string(picked.size()));
   picked.resize(count);
-  // Refine: the apex is the vertex farthest from the chord across the corner.
+  // Refine: the apex is the vertex farthest from the chord across the corner, on
+  // its outer side (a notch beside a rounded corner can reach farther inwards).
   for (size_t& c : picked) {
     const Vec3 a = loopPointAt(pts, cum, total, cum[c] - w), b = loopPointAt(pts, cum, total, cum[c] + w);
     const Vec3 ab = (b - a).normalized();
     double best = -1;
     size_t best_i = c;
     for (size_t i = 0; i < n; ++i) {
-      if (arcDist(i, c) > w) continue;
+      if (arcDist(i, c) > w || (pts[i] - a).cross(b - pts[i]).dot(loop_normal) < 0) continue;
       const Vec3 d = pts[i] - a;
       const double dist = (d - ab * d.dot(ab)).norm();
       if (dist > best) {

@@ -26,10 +26,11 @@ struct SmoothingParams {
   // within 0.48 m, over half the 0.9 m chord at 3/4 height, and that section's
   // camber came out 0.45 % low. The radius is held to this fraction of the sail's
   // size (√ of its area, from the density) by taking fewer neighbours, down to 40:
-  // k ≤ π · ratio² · points, 1.5 % of the sail's points at 0.07. There the bias at
-  // 5,000 points falls to about 0.2 %, 12,000-point clouds keep their end-angle
-  // noise, and denser ones are left alone (0.06 flattens a little less at 5,000
-  // points but adds end-angle noise at 12,000). A cloud noisier for its size than
+  // k ≤ π · ratio² · points, 1.5 % of the sail's points at 0.07: any cloud under
+  // 13,000 points takes fewer than 200. There the bias at 5,000 points falls to
+  // about 0.2 %; at 12,000 (k ≈ 185) the sweeps' end angles are as noisy as
+  // before, and denser clouds are left alone (0.06 flattens a little less at
+  // 5,000 points but adds end-angle noise at 12,000). A cloud noisier for its size than
   // 4 mm (good_m) on that 18 m² sail gains more from averaging: the limit grows as
   // (relative noise)^0.2, so a 1:5 wind-tunnel model under 4 mm noise keeps
   // about the neighbourhood it had without the limit.
@@ -64,7 +65,7 @@ struct Smoothing {
   double max_displacement_m = 0;
   double mean_radius_m = 0;           // mean neighbourhood radius used
   size_t k_used = 0;                  // neighbours per fit: k_neighbours, more in a dense cloud
-  double measured_noise_m = 0;        // the cloud's noise as measured (see adapt_to_noise)
+  double measured_noise_m = 0;        // the cloud's noise as measured (adapt_to_noise, max_radius_ratio)
   size_t fitted_surfaces = 0;         // local surfaces fitted (every point's without anchors)
   std::vector<std::string> warnings;
 };

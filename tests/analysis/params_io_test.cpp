@@ -56,6 +56,7 @@ AnalysisParams changedParams() {
   p.smoothing.k_neighbours = 80;
   p.smoothing.polynomial_order = 1;
   p.smoothing.fair_m = 0.014;
+  p.smoothing.max_radius_ratio = 0.05;
   p.surface.projection = "scan_angles";
   p.surface.max_edge_factor = 3.0;
   p.surface.largest_component_only = false;
@@ -88,6 +89,7 @@ TEST(ParamsJson, RoundTripsEveryChangedField) {
   EXPECT_EQ(out.region_growing.max_points, 123456789012ull);
   EXPECT_EQ(out.sail_pick.seed_point, (std::vector<double>{1.5, -0.25, 4.0}));
   EXPECT_EQ(out.smoothing.polynomial_order, 1);
+  EXPECT_DOUBLE_EQ(out.smoothing.max_radius_ratio, 0.05);
   EXPECT_FALSE(out.surface.largest_component_only);
   EXPECT_EQ(out.outline.design_lengths_m, (std::vector<double>{10.0, 10.5, 3.6}));
   EXPECT_EQ(out.sections.fractions, (std::vector<double>{0.2, 0.4, 0.6, 0.8}));

@@ -119,8 +119,8 @@ TEST(Pipeline, ASquareHeadUnderAMetreWideKeepsItsFourCorners) {
   // A 0.9 m head on a 12 m luff, 3 % of the 29 m outline. A 4th corner once had to
   // stand 4 corner windows (1 % of the outline each) from the others, and this
   // one, 3.0 windows from the head, made the sail a triangle with its head midway
-  // across the top edge. Kinks beside a triangle's head turn under 35°; this
-  // peak turns 70°.
+  // across the top edge. Kinks beside a triangle's head turn under 40° over the
+  // window (under 20° over twice it); this peak turns 70°.
   SailDesign design = exampleDesign(SailType::SquareTopMain);
   design.luff_m = 12.0;
   design.leech_m = 12.1;
@@ -326,7 +326,9 @@ TEST(Pipeline, ANotchInASparseLeechIsNotTakenForTheTack) {
   // 5,000 samples, 6 cm apart: on this seed the mesh leaves a 9 cm deep notch in the
   // leech halfway up, which turned the boundary more sharply than the rounded tack
   // and was named the tack (4.4 m off; every twist 145-161° off). Corners turn
-  // outwards, the notch inwards.
+  // outwards, the notch inwards. (This seed's notch depends on the sampling; the
+  // sheet with a wedge cut in, SailOutline.ANotchCutIntoAnEdgeIsNoCorner, holds the
+  // case whatever the generator does.)
   const SailDesign design = exampleDesign(SailType::Main);
   const SailSurface truth(design);
   const SailAnalysis a = analyzeSail(sampleSail(design, scan(5000, 4)));

@@ -112,11 +112,12 @@ TEST(LiveMode, SweepsAreAnalysedOneAfterAnotherAFailureIsReportedAndStopEndsIt) 
     ASSERT_EQ(rows.size(), 2u);
     for (const SectionRow& r : rows) {
       ASSERT_TRUE(r.delta.has_value());
-      // The sail flies as designed. 4 mm noise (SPEC §3) over a 3 m chord moves camber by tenths of a
-      // percent; the upper section, seen at 50° elevation with 0.1 m between lines (about 4,900 points on
-      // the sail), by up to a percent: it reads 0.3-0.4 % low with the smoothing's radius held to the
-      // sail's size (0.8-1.0 % before).
-      EXPECT_LT(std::abs(r.delta->camber_pct), 1.5) << "f " << r.fraction;
+      // The sail flies as designed. 4 mm noise (SPEC §3) over a 3 m chord moves camber by a tenth of a
+      // percent. The upper section, seen at 50° elevation with 0.1 m between lines (about 4,900 points
+      // on the sail, 1.2 m chord), reads 0.3-0.4 % low, spread ±0.05 % from sweep to sweep: what the
+      // smoothing still flattens at that density. With the smoothing's radius not held to the sail's
+      // size it read 0.77-1.01 % low.
+      EXPECT_LT(std::abs(r.delta->camber_pct), 0.7) << "f " << r.fraction;
       EXPECT_LT(std::abs(r.delta->twist_deg), 2.5) << "f " << r.fraction;
     }
     EXPECT_FALSE(s.scene->surface.empty());
