@@ -373,6 +373,67 @@ TEST(Pipeline, NoCornerLandsFarBeyondTheSamples) {
   }
 }
 
+TEST(Pipeline, ATiltThatLosesTheCurveKeepsTheLastPlaneThatHeldIt) {
+  // The design mesh of the example main with every triangle taken out that a plane
+  // tilted 0.3-3° about the half-height chord would cut and the start plane does not:
+  // the start plane holds its whole curve, every tilted one crosses holes. With no
+  // bridging allowed, the normal search's first tilt loses the curve and the section
+  // is measured in the start plane, with a warning, not left unmeasured.
+  const SailDesign design = exampleDesign(SailType::Main);
+  const SailSurface truth(design);
+  Mesh mesh = generateSailMesh(design, 1200, 80);  // rows under a centimetre: a tilt moves the cut to others
+  const SailOutline outline = extractOutline(mesh);
+  SectionParams start;
+  start.fractions = {0.5};
+  start.plane = "perpendicular";
+  const Section s0 = cutSections(mesh, outline, start).sections.at(0);
+  SectionParams p;
+  p.fractions = {0.5};
+  p.max_bridged_gap = 0;
+  // Whole, the mesh lets the search tilt the plane by more than the 0.3° left alone.
+  const Section whole = cutSections(mesh, outline, p).sections.at(0);
+  ASSERT_TRUE(whole.converged);
+  ASSERT_GT(std::abs(whole.plane_tilt_deg), 0.5);
+  const Vec3 c_hat = (s0.leech_point - s0.luff_point).normalized();
+  const Vec3 m0 = s0.plane_normal, e0 = c_hat.cross(m0);
+  using Triangle = std::array<uint32_t, 3>;
+  auto cuts = [&](const Triangle& t, const Vec3& m) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (uint32_t v : t) {
+      const double d = (mesh.vertices[v] - s0.luff_point).dot(m);
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+    return lo <= 0 && hi >= 0;
+  };
+  std::vector<Triangle> kept;
+  for (const Triangle& t : mesh.triangles) {
+    bool tilted = false;
+    for (int k = 1; k <= 10 && !tilted; ++k)
+      for (double sign : {-1.0, 1.0}) {
+        const double a = sign * (0.3 + 0.27 * (k - 1)) * M_PI / 180.0;
+        tilted = tilted || cuts(t, (std::cos(a) * m0 + std::sin(a) * e0).normalized());
+      }
+    if (cuts(t, m0) || !tilted) kept.push_back(t);
+  }
+  ASSERT_LT(kept.size(), mesh.triangles.size());
+  mesh.triangles = std::move(kept);
+
+  const SectionAnalysis a = cutSections(mesh, outline, p);
+  ASSERT_EQ(a.sections.size(), 1u);
+  EXPECT_TRUE(a.unmeasured.empty());
+  const Section& s = a.sections[0];
+  EXPECT_DOUBLE_EQ(s.plane_tilt_deg, 0.0);
+  EXPECT_FALSE(s.converged);
+  EXPECT_TRUE((s.plane_normal - m0).norm() < 1e-12);
+  bool kept_warning = false;
+  for (const std::string& w : a.warnings) kept_warning = kept_warning || w.find("; kept at 0.0 deg") != std::string::npos;
+  EXPECT_TRUE(kept_warning);
+  // The start plane lies within a degree or two of the normal-aligned one: the section
+  // still meets the clean camber target.
+  EXPECT_NEAR(s.value.camber_pct, truth.section(0.5).camber_pct, 0.1);
+}
+
 TEST(Pipeline, SceneWithMastBoomAndDeckIsSegmentedToTheSail) {
   const SailDesign design = exampleDesign(SailType::Main);
   const ScanSimulation sim = scan(40000, 1, 0.004);
