@@ -287,13 +287,24 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
     // The neighbourhood radius: the median k-th neighbour distance over a sample of points.
     // One grid serves both medians: its searches are exact at any cell width.
     const std::unique_ptr<PointGrid> median_grid = gridForNeighbours(pts, k);
-    double radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
+    auto radiusFor = [&](size_t neighbours) {
+      return std::max(1e-6, medianNeighbourDistance(*median_grid, pts, neighbours, 256));
+    };
+    double radius = radiusFor(k);
     const double density = static_cast<double>(k) / (M_PI * radius * radius);  // points/m² on the surface
     if (p.reference_density_per_m2 > 0 && density > p.reference_density_per_m2) {
       k = std::min(pts.size(), static_cast<size_t>(std::lround(static_cast<double>(k) *
                                                                std::sqrt(density / p.reference_density_per_m2))));
-      radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
+      radius = radiusFor(k);
     }
+    // Fewer neighbours, k × factor but not under kMinAdaptedK; never more than now.
+    auto takeFewer = [&](double factor) {
+      const size_t fewer = std::max<size_t>(kMinAdaptedK, std::lround(static_cast<double>(k) * factor));
+      if (fewer < k) {
+        k = std::min(fewer, pts.size());
+        radius = radiusFor(k);
+      }
+    };
     if (p.adapt_to_noise || p.max_radius_ratio > 0) result.measured_noise_m = measuredNoise(pts, *median_grid);
     if (p.max_radius_ratio > 0) {
       const double sail_size = std::sqrt(static_cast<double>(pts.size()) / density);
@@ -302,25 +313,11 @@ Smoothing smoothMls(const Cloud& cloud, const SmoothingParams& p, const Progress
       // bias grows as radius⁴, the noise left falls as 1 / radius).
       const double relative_noise = (result.measured_noise_m / sail_size) / (p.good_m / kReferenceSailSize);
       const double max_radius = p.max_radius_ratio * std::pow(std::max(1.0, relative_noise), 0.2) * sail_size;
-      if (radius > max_radius) {
-        const size_t fewer = std::max<size_t>(
-            kMinAdaptedK, std::lround(static_cast<double>(k) * (max_radius / radius) * (max_radius / radius)));
-        if (fewer < k) {
-          k = std::min(fewer, pts.size());
-          radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
-        }
-      }
+      if (radius > max_radius) takeFewer((max_radius / radius) * (max_radius / radius));
     }
     if (p.adapt_to_noise) {
       const double ratio = result.measured_noise_m / (0.5 * p.good_m);
-      if (ratio < 1) {
-        const size_t fewer =
-            std::max<size_t>(kMinAdaptedK, std::lround(static_cast<double>(k) * std::sqrt(std::max(0.0, ratio))));
-        if (fewer < k) {
-          k = std::min(fewer, pts.size());
-          radius = std::max(1e-6, medianNeighbourDistance(*median_grid, pts, k, 256));
-        }
-      }
+      if (ratio < 1) takeFewer(std::sqrt(std::max(0.0, ratio)));
     }
     result.k_used = k;
     // Gathered from a grid a little wider than the radius, so the k nearest of
