@@ -738,6 +738,8 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   // area the loop encloses), so that the loop turns anticlockwise about it.
   Vec3 loop_normal = Vec3::Zero();
   for (size_t i = 0; i < n; ++i) loop_normal += pts[i].cross(pts[(i + 1) % n]);
+  // Whether the loop, arriving along `in` and leaving along `out`, turns outwards.
+  auto outwards = [&](const Vec3& in, const Vec3& out) { return in.cross(out).dot(loop_normal) >= 0; };
   // Turning angle over arms of length `arm`; at a corner it approaches the exterior
   // angle. Negative where the loop turns inwards: a sail's corners all bulge out,
   // and a notch in a sparse edge (a triangle the long-edge limit left out) turns as
@@ -748,7 +750,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
     const Vec3 b = loopPointAt(pts, cum, total, cum[i] + arm) - pts[i];
     const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
     const double angle = std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
-    return a.cross(b).dot(loop_normal) >= 0 ? angle : -angle;
+    return outwards(a, b) ? angle : -angle;
   };
   std::vector<double> turn(n);
   for (size_t i = 0; i < n; ++i) turn[i] = turnAt(i, w);
@@ -804,7 +806,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
     double best = -1;
     size_t best_i = c;
     for (size_t i = 0; i < n; ++i) {
-      if (arcDist(i, c) > w || (pts[i] - a).cross(b - pts[i]).dot(loop_normal) < 0) continue;
+      if (arcDist(i, c) > w || !outwards(pts[i] - a, b - pts[i])) continue;
       const Vec3 d = pts[i] - a;
       const double dist = (d - ab * d.dot(ab)).norm();
       if (dist > best) {
