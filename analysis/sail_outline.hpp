@@ -13,7 +13,8 @@ namespace sailshape {
 struct OutlineParams {
   int corners = 0;                    // 0: auto (3, or 4 when a 4th turns enough), 3 or 4
   double corner_window_m = 0.0;       // arm length for the turning angle; 0: 1 % of the boundary length
-  double min_fourth_corner_deg = 40;  // auto: a 4th corner turns at least this over twice the corner window (half of it over the window)
+  // auto: a 4th corner turns at least this over twice the corner window, and half of it over the window
+  double min_fourth_corner_deg = 40;
   double edge_smoothing_m = 0.0;      // moving-average window along the edges; 0: 0.6 % of boundary length
   // Design lengths [luff, leech, foot] in metres to check against (empty: no check);
   // more than design_tolerance off stops the analysis (SPEC §4 step 6).

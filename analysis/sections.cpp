@@ -472,13 +472,13 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
   // when that plane finds no curve spanning the chord.
   std::string why;
   auto cutAt = [&](double angle) {
-    Frame g = f;
-    g.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
-    g.y_hat = g.m.cross(g.c_hat);
-    auto cuts = cutMesh(mesh, g.L, g.m);
+    Frame tilted = f;
+    tilted.m = (std::cos(angle) * m0 + std::sin(angle) * e0).normalized();
+    tilted.y_hat = tilted.m.cross(tilted.c_hat);
+    auto cuts = cutMesh(mesh, tilted.L, tilted.m);
     Cut c;
-    if (!pickCut(cuts, g, p.max_bridged_gap, c, why)) return false;
-    f = g;
+    if (!pickCut(cuts, tilted, p.max_bridged_gap, c, why)) return false;
+    f = tilted;
     cut = std::move(c);
     phi = angle;
     return true;
@@ -492,8 +492,8 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
     auto tiltTo = [&](double angle) {
       if (cutAt(angle)) return true;
       warnings.push_back("section " + formatFixed(t, 3) + ": the plane tilted " +
-                                formatFixed(angle * kDeg, 1) + " deg " + why + "; kept at " +
-                                formatFixed(phi * kDeg, 1) + " deg");
+                         formatFixed(angle * kDeg, 1) + " deg " + why + "; kept at " +
+                         formatFixed(phi * kDeg, 1) + " deg");
       return false;
     };
     for (int it = 0; it < p.max_iterations; ++it) {
@@ -518,7 +518,7 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
     }
     if (!s.converged)
       warnings.push_back("section " + formatFixed(t, 3) + ": the plane did not reach the surface normal within " +
-                                std::to_string(p.normal_tolerance_deg) + " deg");
+                         std::to_string(p.normal_tolerance_deg) + " deg");
   }
   s.plane_tilt_deg = phi * kDeg;
   s.plane_normal = f.m;
@@ -562,7 +562,7 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
       }
     } else {
       warnings.push_back("section " + formatFixed(t, 3) +
-                                ": no crest in the peak fit; the deepest cut point is used");
+                         ": no crest in the peak fit; the deepest cut point is used");
     }
   }
   s.max_camber_point = f.L + depth_x * f.c_hat + side * depth * f.y_hat;
@@ -592,14 +592,14 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
     if (!q.ok) {
       sd_deg = std::numeric_limits<double>::quiet_NaN();
       warnings.push_back("section " + formatFixed(t, 3) + ": too few points for the " + which + " angle (" +
-                                std::to_string(win.size()) + " within " + formatFixed(100 * window, 0) +
-                                " % of the chord)");
+                         std::to_string(win.size()) + " within " + formatFixed(100 * window, 0) +
+                         " % of the chord)");
       return std::numeric_limits<double>::quiet_NaN();
     }
     if (window > p.end_window)
       warnings.push_back("section " + formatFixed(t, 3) + ": the " + which + " angle is read from " +
-                                std::to_string(win.size()) + " points over " + formatFixed(100 * window, 0) +
-                                " % of the chord (too few within " + formatFixed(100 * p.end_window, 0) + " %)");
+                         std::to_string(win.size()) + " points over " + formatFixed(100 * window, 0) +
+                         " % of the chord (too few within " + formatFixed(100 * p.end_window, 0) + " %)");
     const double slope = at_luff ? q.c[1] : -q.c[1];
     const double inflate = correlationInflation(win.size(), window * f.chord, p.noise_correlation_m);
     sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDeg;

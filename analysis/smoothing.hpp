@@ -30,11 +30,10 @@ struct SmoothingParams {
   // 13,000 points takes fewer than 200. There the bias at 5,000 points falls to
   // about 0.2 %; at 12,000 (k ≈ 185) the sweeps' end angles are as noisy as
   // before, and denser clouds are left alone (0.06 flattens a little less at
-  // 5,000 points but adds end-angle noise at 12,000). A cloud noisier for its size than
-  // 4 mm (good_m) on that 18 m² sail gains more from averaging: the limit grows as
-  // (relative noise)^0.2, so a 1:5 wind-tunnel model under 4 mm noise keeps
-  // about the neighbourhood it had without the limit.
-  // 0: no limit.
+  // 5,000 points but adds end-angle noise at 12,000). A cloud noisier for its
+  // size than 4 mm (good_m) on that 18 m² sail gains more from averaging: the
+  // limit grows as (relative noise)^0.2, so a 1:5 wind-tunnel model under 4 mm
+  // noise keeps about the neighbourhood it had without the limit. 0: no limit.
   double max_radius_ratio = 0.07;
   // Those neighbourhoods are sized for the sensor's noise (good_m). A cloud whose
   // measured noise (the RMS off quadratics through 24 neighbours) is under half of

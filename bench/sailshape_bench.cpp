@@ -220,9 +220,8 @@ void BM_Ours_WholeAnalysis(benchmark::State& state) {
     const SailAnalysis a = analyzeSail(c);
     for (const StageReport& r : a.stages) stage_ms[r.name] += 1e3 * r.seconds;
     unmeasured += a.sections.unmeasured.size();
-    for (const Section& s : a.sections.sections)
-      unmeasured += !std::isfinite(s.value.entry_deg) + !std::isfinite(s.value.exit_deg);
     for (const Section& s : a.sections.sections) {
+      unmeasured += !std::isfinite(s.value.entry_deg) + !std::isfinite(s.value.exit_deg);
       const KnownSection k = truth.section(s.fraction);
       camber = std::max(camber, std::abs(s.value.camber_pct - k.camber_pct));
       draft = std::max(draft, std::abs(s.value.draft_pct - k.draft_pct));
