@@ -97,14 +97,42 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
   std::vector<uint32_t> near;
   for (uint32_t i = 0; i < cloud.size(); ++i)
     if (!in_sail[i] && !broad[i] && box.contains(cloud.points[i])) near.push_back(i);
-  const SparSearch found = findSpars(cloud, normals, near, sp);
+  const SparSearch found = findSpars(cloud, normals, near, sp, sail);
   a.spars = found.spars;
   if (found.spars.empty()) return sail;
   const double sigma = p.sensor_sigma_m;
+  // Which spar is nearest x, and how far x lies off it.
   auto nearestSpar = [&](const Vec3& x) {
-    double d = std::numeric_limits<double>::infinity();
-    for (const SparFit& f : found.spars) d = std::min(d, distanceToSpar(x, f.spar));
-    return d;
+    std::pair<double, size_t> best{std::numeric_limits<double>::infinity(), 0};
+    for (size_t s = 0; s < found.spars.size(); ++s)
+      best = std::min(best, std::make_pair(distanceToSpar(x, found.spars[s].spar), s));
+    return best;
+  };
+  // The unit direction across spar s from its axis to x.
+  auto across = [&](const Vec3& x, size_t s) {
+    const Spar& spar = found.spars[s].spar;
+    const Vec3 d = x - spar.base;
+    return (d - d.dot(spar.axis) * spar.axis).normalized();
+  };
+  std::vector<std::pair<double, size_t>> to_spar(cloud.size(), {std::numeric_limits<double>::infinity(), 0});
+  for (uint32_t i = 0; i < cloud.size(); ++i)
+    if (box.contains(cloud.points[i])) to_spar[i] = nearestSpar(cloud.points[i]);
+  // The side of each spar the sail lies on: the mean direction across it to the sail's
+  // points within half a metre.
+  std::vector<Vec3> sail_side(found.spars.size(), Vec3::Zero());
+  for (uint32_t i : sail)
+    if (to_spar[i].first > 2 * sigma && to_spar[i].first < 0.5)
+      sail_side[to_spar[i].second] += across(cloud.points[i], to_spar[i].second);
+  for (Vec3& v : sail_side)
+    if (v.norm() > 0) v.normalize();
+  // A loose point 3σ-6σ off a spar's surface is the sail's edge strip when it lies on the
+  // sail's side of the spar, within 60°. On another side it is more likely one of the
+  // spar's own points that noise put out so far (one in a few hundred): one such came back
+  // into a sparse sweep's sail as a point of its surface and took the tack 30 cm up the mast.
+  auto offSpar = [&](uint32_t i) {
+    const auto [d, s] = to_spar[i];
+    if (!std::isfinite(d) || d <= 3 * sigma) return false;
+    return d > 6 * sigma || sail_side[s].norm() == 0 || across(cloud.points[i], s).dot(sail_side[s]) >= 0.5;
   };
   std::vector<char> loose(cloud.size(), 0);
   for (uint32_t i : seg.unassigned) loose[i] = !in_sail[i];
@@ -113,10 +141,10 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
   // `sub` ascends, and `kept` indexes the sail's part of it, as readmitSurfacePoints needs.
   std::vector<uint32_t> sub, kept;
   for (uint32_t i = 0; i < cloud.size(); ++i) {
-    if (in_sail[i] && nearestSpar(cloud.points[i]) > 2 * sigma) {
+    if (in_sail[i] && to_spar[i].first > 2 * sigma) {
       kept.push_back(static_cast<uint32_t>(sub.size()));
       sub.push_back(i);
-    } else if (loose[i] && box.contains(cloud.points[i]) && nearestSpar(cloud.points[i]) > 3 * sigma) {
+    } else if (loose[i] && offSpar(i)) {
       sub.push_back(i);
     }
   }

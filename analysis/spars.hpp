@@ -54,8 +54,11 @@ struct SparSearchParams {
   double min_radius_m = 0.01;
   double max_radius_m = 0.25;
   double min_length_radii = 8;    // a spar is long: its supported length is at least this × its radius
-  double min_arc_deg = 100;       // the supporting points cover at least this much of the circumference
-                                  // (a scanner sees about half of it; a strip of a flat surface far less)
+  // The supporting points span at least this much of the circumference, and a quarter
+  // more than a flat strip could lie within the band at the fitted radius (66° at 9 cm,
+  // so 83°). A scanner sees about half the girth; a turntable's fans cross a mast 6 m
+  // away at 0.6° in three lines, which span about 90-100° of a 9 cm mast.
+  double min_arc_deg = 80;
   size_t min_support = 100;
   int hypotheses = 400;           // random two-point samples per spar
   int max_spars = 3;
@@ -71,9 +74,12 @@ struct SparSearch {
 // cylinder (its axis is across both normals), the hypothesis most candidates fit wins and
 // is refined by least squares on its axis, direction and radius; its points are taken
 // out and the next spar searched, up to max_spars. `normals` has one per cloud point.
-// Throws InvalidInput for a normals/cloud size mismatch, an index out of range or bad
-// parameters.
+// A found spar's length runs on through the points of `length_from` on its surface
+// (the sail cluster, which can have grown over the mast beside its luff) for as long as
+// they keep round it, two scan lines' worth of its girth at least; they are not
+// searched. Throws InvalidInput for a normals/cloud size mismatch, an index out of range
+// or bad parameters.
 SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const std::vector<uint32_t>& candidates,
-                     const SparSearchParams& params = {});
+                     const SparSearchParams& params = {}, const std::vector<uint32_t>& length_from = {});
 
 }  // namespace sailshape

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <map>
 #include <random>
 
 #include "analysis/errors.hpp"
@@ -191,6 +193,122 @@ TEST(FindSpars, OnlyTheCandidatesAreSearched) {
   EXPECT_EQ(findSpars(c, n.normals.normals, everyIndex(c)).spars.size(), 1u);
 }
 
+// A turntable scanner at `eye` (shaft vertical): vertical fans every 0.6° of azimuth
+// from az0 to az1 (degrees from +x towards +y), samples every 0.5° of elevation from
+// -10° to 65°, with σ range noise. A ray returns from the nearest of an upright round
+// mast (axis at mast_xy, radius r, z 0-11.5 m) and a flat sheet y = 0.05 (x from -3 m
+// to 5 cm aft of the mast, z 0.3-11 m), and nothing beyond 75° incidence. is_mast
+// marks the mast's points.
+Cloud fanScan(const Vec3& eye, double az0, double az1, const Eigen::Vector2d& mast_xy, double r,
+              std::vector<char>& is_mast, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> N(0.0, kSigma);
+  Cloud c;
+  is_mast.clear();
+  const double deg = kPi / 180;
+  for (double az = az0; az <= az1; az += 0.6)
+    for (double el = -10; el <= 65; el += 0.5) {
+      const Eigen::Vector2d h(std::cos(az * deg), std::sin(az * deg));
+      const Vec3 ray(std::cos(el * deg) * h.x(), std::cos(el * deg) * h.y(), std::sin(el * deg));
+      const Eigen::Vector2d e = eye.head<2>() - mast_xy;
+      double best = std::numeric_limits<double>::infinity(), cos_inc = 0;
+      bool mast = false;
+      // s: horizontal distance along the fan.
+      const double b = h.dot(e), disc = b * b - (e.squaredNorm() - r * r);
+      if (disc > 0) {
+        const double s = -b - std::sqrt(disc);
+        const double z = eye.z() + s * std::tan(el * deg);
+        if (s > 0 && z >= 0 && z <= 11.5) {
+          best = s;
+          const Eigen::Vector2d radial = (e + s * h) / r;
+          cos_inc = -radial.dot(h) * std::cos(el * deg);
+          mast = true;
+        }
+      }
+      if (h.y() > 1e-9) {
+        const double s = (0.05 - eye.y()) / h.y();
+        const double x = eye.x() + s * h.x(), z = eye.z() + s * std::tan(el * deg);
+        if (s < best && x >= -3.0 && x <= mast_xy.x() - r - 0.05 && z >= 0.3 && z <= 11.0) {
+          best = s;
+          cos_inc = ray.y();
+          mast = false;
+        }
+      }
+      if (!std::isfinite(best) || cos_inc < std::cos(75 * deg)) continue;
+      const double range = best / std::cos(el * deg) + N(rng);
+      c.points.push_back(eye + range * ray);
+      is_mast.push_back(mast);
+    }
+  return c;
+}
+
+TEST(FindSpars, AMastCrossedByThreeScanLinesIsFoundAndRunsOnThroughTheSailsPointsOnIt) {
+  // As live mode's deck unit sees the mast 6 m away: 0.6° between fans is 6.4 cm, so
+  // two or three fans cross a 9 cm mast, as the fans' phase falls. Three span 90-100° of
+  // its girth, more than a flat strip could; two lines lie in a plane, and no spar is
+  // found. The sail's region grew up the mast beside its luff: the search has the mast's
+  // points below 6 m, the sail cluster holds those above.
+  const Vec3 eye(1.5, -6.0, 1.2);
+  const Eigen::Vector2d mast_xy(0.1, 0.0);
+  int three_fans = 0;
+  for (int phase = 0; phase < 6; ++phase) {
+    SCOPED_TRACE("fans from " + std::to_string(95.0 + 0.1 * phase) + "°");
+    std::vector<char> is_mast;
+    const Cloud c = fanScan(eye, 95.0 + 0.1 * phase, 140.0, mast_xy, 0.09, is_mast, static_cast<uint32_t>(phase + 1));
+    std::vector<uint32_t> low_mast, sail;
+    std::map<long, double> fan_top;  // the highest mast point of each fan (by azimuth)
+    for (uint32_t i = 0; i < c.size(); ++i) {
+      const Vec3& x = c.points[i];
+      if (is_mast[i]) {
+        double& t = fan_top[std::lround(std::atan2(x.y() - eye.y(), x.x() - eye.x()) * 180 / kPi / 0.6)];
+        t = std::max(t, x.z());
+      }
+      (is_mast[i] && x.z() < 6.0 ? low_mast : sail).push_back(i);
+    }
+    ASSERT_GE(fan_top.size(), 2u);
+    ASSERT_LE(fan_top.size(), 3u);
+    const NormalEstimation n = estimateNormals(c);
+    const SparSearch alone = findSpars(c, n.normals.normals, low_mast);
+    if (fan_top.size() == 2) {
+      EXPECT_TRUE(alone.spars.empty()) << "two lines could be a flat strip";
+      continue;
+    }
+    ++three_fans;
+    ASSERT_EQ(alone.spars.size(), 1u) << "three fans span more of the girth than a flat strip could";
+    const Spar& lower = alone.spars[0].spar;
+    EXPECT_LT(angleDeg(lower.axis, Vec3::UnitZ()), 1.0);
+    // A few hundred points to σ: the radius within σ.
+    EXPECT_NEAR(lower.radius_m, 0.09, kSigma);
+    auto topOf = [](const Spar& m) { return std::max(m.base.z(), m.base.z() + m.length_m * m.axis.z()); };
+    EXPECT_LT(topOf(lower), 6.0) << "without the sail's points it ends where its own do";
+
+    const SparSearch s = findSpars(c, n.normals.normals, low_mast, {}, sail);
+    ASSERT_EQ(s.spars.size(), 1u);
+    const Spar& mast = s.spars[0].spar;
+    std::vector<double> tops;
+    for (const auto& [fan, t] : fan_top) tops.push_back(t);
+    std::sort(tops.rbegin(), tops.rend());
+    // It runs up as far as two fans' points do, to within two samples (0.5° at 11 m is
+    // 10 cm), and no further than the mast.
+    EXPECT_GT(topOf(mast), tops[1] - 0.2);
+    EXPECT_LT(topOf(mast), 11.5 + 2 * kSigma);
+    // The sheet's luff, 5 cm off the mast's aft face, keeps every point: none is within
+    // the 2σ the pipeline takes off a spar.
+    for (uint32_t i : sail)
+      if (!is_mast[i]) ASSERT_GT(distanceToSpar(c.points[i], mast), 2 * kSigma) << c.points[i].transpose();
+  }
+  EXPECT_GE(three_fans, 3);
+}
+
+TEST(FindSpars, AFlatSheetInScanLinesIsNoSpar) {
+  // Without the mast: no two fans' points on the sheet lie on one round surface.
+  std::vector<char> is_mast;
+  const Cloud c = fanScan(Vec3(1.5, -6.0, 1.2), 95.0, 140.0, Eigen::Vector2d(50.0, 0.0), 0.09, is_mast, 4);
+  ASSERT_GT(c.size(), 5000u);
+  const NormalEstimation n = estimateNormals(c);
+  EXPECT_TRUE(findSpars(c, n.normals.normals, everyIndex(c)).spars.empty());
+}
+
 TEST(FindSpars, RejectsMismatchedNormalsBadIndicesAndBadParameters) {
   std::mt19937 rng(2);
   Cloud c;
@@ -198,6 +316,7 @@ TEST(FindSpars, RejectsMismatchedNormalsBadIndicesAndBadParameters) {
   const std::vector<Vec3> normals(c.size(), Vec3::UnitX());
   EXPECT_THROW(findSpars(c, std::vector<Vec3>(c.size() - 1, Vec3::UnitX()), everyIndex(c)), InvalidInput);
   EXPECT_THROW(findSpars(c, normals, {static_cast<uint32_t>(c.size())}), InvalidInput);
+  EXPECT_THROW(findSpars(c, normals, everyIndex(c), {}, {static_cast<uint32_t>(c.size())}), InvalidInput);
   SparSearchParams bad;
   bad.max_radius_m = bad.min_radius_m;
   EXPECT_THROW(findSpars(c, normals, everyIndex(c), bad), InvalidInput);

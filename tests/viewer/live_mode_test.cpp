@@ -10,8 +10,10 @@
 #include <thread>
 
 #include "acquisition/scene.hpp"
+#include "analysis/cloud_io.hpp"
 #include "analysis/errors.hpp"
 #include "analysis/sail_generator.hpp"
+#include "analysis/spars.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/catalog_tree.hpp"
 #include "viewer/live_mode.hpp"
@@ -115,8 +117,9 @@ TEST(LiveMode, SweepsAreAnalysedOneAfterAnotherAFailureIsReportedAndStopEndsIt) 
       // The sail flies as designed. 4 mm noise (SPEC §3) over a 3 m chord moves camber by a tenth of a
       // percent. The upper section, seen at 50° elevation with 0.1 m between lines (about 4,900 points
       // on the sail, 1.2 m chord), usually reads 0.3-0.4 % low (0.77-1.01 % before the smoothing's
-      // radius was held to the sail's size). About one sweep in twenty reads it 1.5-2 % off, a defect
-      // not yet found; a 0.7 % limit caught one at 1.49 % in CI, so the limit stays at 1.5 %.
+      // radius was held to the sail's size). Sweeps whose sail took in the mast read it 1.3-4.8 % off
+      // (CapturedDeckSweepsKeepTheMastOutOfTheSail below); where only two fans cross the mast it
+      // cannot be told from a flat strip, so the limit stays at 1.5 %.
       EXPECT_LT(std::abs(r.delta->camber_pct), 1.5) << "f " << r.fraction;
       EXPECT_LT(std::abs(r.delta->twist_deg), 2.5) << "f " << r.fraction;
     }
@@ -183,6 +186,50 @@ TEST(LiveMode, RefusesWhatItCannotDo) {
   EXPECT_THROW(sailRoi(deckMain(), 0.3, 50.0), InvalidInput) << "a deck above the head";
   EXPECT_THROW(designedSailParams(deckMain(), 0), InvalidInput);
   EXPECT_THROW(designedSailParams(deckMain(), 21), InvalidInput);
+}
+
+// Sweeps of the emulated deck unit, captured as live mode stored them (tests/viewer/data/README.md),
+// each analysed as live mode does. The sail flies as designed. Both once went wrong at the mast,
+// 6 m from the unit, which its fans, 6.4 cm apart there, cross in two or three lines:
+// - deck-sweep-mast-in-sail.ply: the sail's region grew up the mast (up to 60 cm forward of the
+//   upper luff); the spar search wanted 100° of its girth filled, which three lines never fill,
+//   and found none. The sail kept about 120 of the mast's points; the upper section read 4.8 %
+//   less camber and 2.3° less twist. (3 of 225 sweeps did this, by 1.3-4.8 %.)
+// - deck-sweep-mast-tail.ply: once the mast was found, one of its points 2.9σ off the fitted
+//   surface came back into the sail as a point of its surface, and the tack moved 30 cm up it.
+TEST(LiveMode, CapturedDeckSweepsKeepTheMastOutOfTheSail) {
+  const Mesh design = deckMain();
+  const SailSurface sail(exampleDesign(SailType::Main));
+  SceneOptions options;
+  options.roi = sailRoi(design, 0.3);
+  options.analysis = designedSailParams(design, 2);
+  for (const char* name : {"deck-sweep-mast-in-sail.ply", "deck-sweep-mast-tail.ply"}) {
+    SCOPED_TRACE(name);
+    ScanRecord record;
+    record.has_design = true;
+    record.cloud = readCloud(std::string(SAILSHAPE_TEST_DATA) + "/" + name).cloud;
+    const ScanScene scene = buildScanScene(std::move(record), design, options);
+    ASSERT_TRUE(scene.analysis.has_value()) << scene.analysis_error;
+    const SailAnalysis& a = *scene.analysis;
+    // The mast: 9 cm radius, upright at (0.1, 0), 12 m tall.
+    ASSERT_GE(a.spars.size(), 1u);
+    const Spar& mast = a.spars[0].spar;
+    EXPECT_NEAR(mast.radius_m, 0.09, 2 * options.analysis.sensor_sigma_m);
+    EXPECT_GT(std::abs(mast.axis.z()), std::cos(1.0 * M_PI / 180));
+    for (const Vec3& x : a.sail_cloud.points)
+      ASSERT_GT(distanceToSpar(x, mast), 2 * options.analysis.sensor_sigma_m) << "a point on the mast: " << x.transpose();
+    // Corners within two samples' spacing (0.5° at 12 m is 10 cm).
+    EXPECT_LT((a.outline.tack - sail.tack()).norm(), 0.2);
+    EXPECT_LT((a.outline.clew - sail.clew()).norm(), 0.2);
+    EXPECT_LT((a.outline.head - sail.head()).norm(), 0.2);
+    ASSERT_EQ(scene.deltas.size(), 2u);
+    for (const SectionDelta& d : scene.deltas) {
+      // As the live-mode test above: the upper section usually reads 0.3-0.4 % camber and 0.7°
+      // twist low in these sparse sweeps.
+      EXPECT_LT(std::abs(d.delta.camber_pct), 0.7) << "f " << d.fraction;
+      EXPECT_LT(std::abs(d.delta.twist_deg), 1.3) << "f " << d.fraction;
+    }
+  }
 }
 
 TEST(LiveMode, TheSailRoiIsTheDesignBoxAboveTheDeck) {
