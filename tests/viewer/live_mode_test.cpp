@@ -117,11 +117,11 @@ TEST(LiveMode, SweepsAreAnalysedOneAfterAnotherAFailureIsReportedAndStopEndsIt) 
       // The sail flies as designed. 4 mm noise (SPEC §3) over a 3 m chord moves camber by a tenth of a
       // percent. The upper section, seen at 50° elevation with 0.1 m between lines (about 4,900 points
       // on the sail, 1.2 m chord), usually reads 0.3-0.4 % low (0.77-1.01 % before the smoothing's
-      // radius was held to the sail's size). Sweeps whose sail took in the mast read it 1.3-4.8 % off
-      // (CapturedDeckSweepsKeepTheMastOutOfTheSail below); where only two fans cross the mast it
-      // cannot be told from a flat strip, so the limit stays at 1.5 %.
-      EXPECT_LT(std::abs(r.delta->camber_pct), 1.5) << "f " << r.fraction;
-      EXPECT_LT(std::abs(r.delta->twist_deg), 2.5) << "f " << r.fraction;
+      // radius was held to the sail's size), and twists 0.7° low. Sweeps whose sail took in the mast
+      // read it 1.3-4.8 % off (CapturedDeckSweepsKeepTheMastOutOfTheSail below); since the mast is
+      // found in them, 225 captured sweeps read it at most 0.52 % and 1.16° off.
+      EXPECT_LT(std::abs(r.delta->camber_pct), 0.8) << "f " << r.fraction;
+      EXPECT_LT(std::abs(r.delta->twist_deg), 1.5) << "f " << r.fraction;
     }
     EXPECT_FALSE(s.scene->surface.empty());
     EXPECT_EQ(s.scene->cluster_deviation_m.size(), s.scene->analysis->sail_cloud.size());
