@@ -194,7 +194,7 @@ TEST(LiveMode, RefusesWhatItCannotDo) {
 // - deck-sweep-mast-in-sail.ply: the sail's region grew up the mast (up to 60 cm forward of the
 //   upper luff); the spar search wanted 100° of its girth filled, which three lines never fill,
 //   and found none. The sail kept about 120 of the mast's points; the upper section read 4.8 %
-//   less camber and 2.3° less twist. (3 of 225 sweeps did this, by 1.3-4.8 %.)
+//   less camber and 2.3° less twist. (3 of 270 sweeps did this, by 1.3-4.8 %.)
 // - deck-sweep-mast-tail.ply: once the mast was found, one of its points 2.9σ off the fitted
 //   surface came back into the sail as a point of its surface, and the tack moved 30 cm up it.
 TEST(LiveMode, CapturedDeckSweepsKeepTheMastOutOfTheSail) {
