@@ -114,9 +114,12 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
     const Vec3 d = x - spar.base;
     return (d - d.dot(spar.axis) * spar.axis).normalized();
   };
+  std::vector<char> loose(cloud.size(), 0);
+  for (uint32_t i : seg.unassigned) loose[i] = !in_sail[i];
+  // Only the sail's points and the loose ones in the box can be kept or come back.
   std::vector<std::pair<double, size_t>> to_spar(cloud.size(), {std::numeric_limits<double>::infinity(), 0});
   for (uint32_t i = 0; i < cloud.size(); ++i)
-    if (box.contains(cloud.points[i])) to_spar[i] = nearestSpar(cloud.points[i]);
+    if (in_sail[i] || (loose[i] && box.contains(cloud.points[i]))) to_spar[i] = nearestSpar(cloud.points[i]);
   // The side of each spar the sail lies on: the mean direction across it to the sail's
   // points within half a metre.
   std::vector<Vec3> sail_side(found.spars.size(), Vec3::Zero());
@@ -134,8 +137,6 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
     if (!std::isfinite(d) || d <= 3 * sigma) return false;
     return d > 6 * sigma || sail_side[s].norm() == 0 || across(cloud.points[i], s).dot(sail_side[s]) >= 0.5;
   };
-  std::vector<char> loose(cloud.size(), 0);
-  for (uint32_t i : seg.unassigned) loose[i] = !in_sail[i];
   // Sail points within 2σ of a spar's surface are more likely the spar's; loose
   // points within 3σ of it stay out (the sail is at least 2 cm off a mast's aft face).
   // `sub` ascends, and `kept` indexes the sail's part of it, as readmitSurfacePoints needs.
