@@ -7,6 +7,8 @@
 #include <optional>
 #include <random>
 
+#include <Eigen/Eigenvalues>
+
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
 
@@ -143,6 +145,16 @@ std::optional<Cylinder> cylinderThrough(const Vec3& p1, const Vec3& n1, const Ve
   return c;
 }
 
+// Whether two cylinders are near-copies: axes within 5°, radii within a quarter, and
+// each axis within half the radius of the other's.
+bool alike(const Cylinder& a, const Cylinder& b) {
+  if (std::abs(a.axis.dot(b.axis)) < std::cos(5.0 * M_PI / 180.0)) return false;
+  const double r = std::max(a.radius, b.radius);
+  if (std::abs(a.radius - b.radius) > 0.25 * r) return false;
+  const Vec3 d = b.point - a.point;
+  return (d - d.dot(a.axis) * a.axis).norm() <= 0.5 * r;
+}
+
 // Along-axis position and angle around the axis of p.
 struct AxialPosition {
   double along, angle;
@@ -234,6 +246,73 @@ Cylinder refineCylinder(const std::vector<Vec3>& pts, Cylinder c, double band) {
   return c;
 }
 
+
+// A refined cylinder that passed as a spar: its points on the surface as (along, angle)
+// sorted along, the run [first, last] of them without a gap, and the tests' limits.
+struct Candidate {
+  Cylinder cylinder;
+  std::vector<std::pair<double, double>> on;
+  size_t first = 0, last = 0;
+  double min_arc = 0, max_gap = 0, rms_m = 0;
+};
+
+// The fraction of `pts` within `band` of their least-squares plane.
+double fractionOnPlane(const std::vector<Vec3>& pts, double band) {
+  if (pts.size() < 3) return 1.0;
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& x : pts) mean += x;
+  mean /= static_cast<double>(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3& x : pts) cov += (x - mean) * (x - mean).transpose();
+  const Vec3 normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  size_t in = 0;
+  for (const Vec3& x : pts) in += std::abs((x - mean).dot(normal)) <= band;
+  return static_cast<double>(in) / static_cast<double>(pts.size());
+}
+
+// Whether the cylinder is a spar among `pts`: within the radius limits, with at least
+// min_support points on its surface in one run along it without a gap of two diameters,
+// that run min_length_radii long, spanning round the axis at least min_arc_deg and a
+// quarter more than a flat strip could lie within the band at its radius, and not lying
+// (nine in ten of them) within the band of one plane: two scan lines crossing a mast fit
+// any cylinder through both, at a radius that makes them span a wide arc.
+std::optional<Candidate> asSpar(const std::vector<Vec3>& pts, const Cylinder& c, const SparSearchParams& p) {
+  const double band = 2 * p.sensor_sigma_m;
+  if (!(c.radius >= p.min_radius_m && c.radius <= p.max_radius_m)) return std::nullopt;
+  Candidate k;
+  k.cylinder = c;
+  std::vector<std::pair<double, size_t>> order;  // (along, index into pts) on the surface
+  double sum2 = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const double r = radialResidual(pts[i], c);
+    if (std::abs(r) > band) continue;
+    order.emplace_back(axialPosition(pts[i], c).along, i);
+    sum2 += r * r;
+  }
+  if (order.size() < p.min_support) return std::nullopt;
+  std::sort(order.begin(), order.end());
+  for (const auto& [along, i] : order) k.on.emplace_back(along, axialPosition(pts[i], c).angle);
+  k.rms_m = std::sqrt(sum2 / static_cast<double>(k.on.size()));
+  // The spar runs as far as its points do without a gap: out from the median, up to the
+  // last point before a gap of more than two diameters (an infinite cylinder also grazes
+  // whatever lies further along its line).
+  k.max_gap = 4 * c.radius + 2 * band;
+  k.first = k.last = k.on.size() / 2;
+  while (k.first > 0 && k.on[k.first].first - k.on[k.first - 1].first <= k.max_gap) --k.first;
+  while (k.last + 1 < k.on.size() && k.on[k.last + 1].first - k.on[k.last].first <= k.max_gap) ++k.last;
+  if (k.on[k.last].first - k.on[k.first].first < p.min_length_radii * c.radius) return std::nullopt;
+  // A spar is round: its points span more of its girth than any flat strip could.
+  k.min_arc = std::max(p.min_arc_deg, 1.25 * flatStripArcDeg(c.radius, band));
+  std::vector<double> angle;
+  for (size_t i = k.first; i <= k.last; ++i) angle.push_back(k.on[i].second);
+  if (spannedArcDeg(angle) < k.min_arc) return std::nullopt;
+  std::vector<Vec3> run;
+  run.reserve(k.last - k.first + 1);
+  for (size_t i = k.first; i <= k.last; ++i) run.push_back(pts[order[i].second]);
+  if (fractionOnPlane(run, band) >= 0.9) return std::nullopt;
+  return k;
+}
+
 }  // namespace
 
 SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const std::vector<uint32_t>& candidates,
@@ -268,9 +347,9 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
     const PointGrid grid(pts, reach);
     std::vector<uint32_t> around;
     std::vector<double> around_d2;
-    auto scoreOf = [&](const Cylinder& c) {
+    auto scoreOf = [&](const Cylinder& c, double within) {
       size_t score = 0;
-      for (size_t k = 0; k < pts.size(); k += stride) score += std::abs(radialResidual(pts[k], c)) <= band;
+      for (size_t k = 0; k < pts.size(); k += stride) score += std::abs(radialResidual(pts[k], c)) <= within;
       return score;
     };
     // Two points' normals give a rough cylinder (a few mm of noise in a normal
@@ -286,51 +365,38 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
       if (i == j) continue;
       const auto c = cylinderThrough(pts[i], normals[pool[i]], pts[j], normals[pool[j]], 4 * p.sensor_sigma_m);
       if (!c || c->radius < p.min_radius_m || c->radius > p.max_radius_m) continue;
-      const size_t score = scoreOf(*c);
+      const size_t score = scoreOf(*c, band);
       if (top.size() == kRefined && score <= top.back().first) continue;
+      // Near-copies of one cylinder would crowd the others out: a better one replaces its
+      // copy, a worse one is dropped.
+      const auto copy = std::find_if(top.begin(), top.end(), [&](const auto& t) { return alike(t.second, *c); });
+      if (copy != top.end()) {
+        if (score <= copy->first) continue;
+        top.erase(copy);
+      }
       top.emplace_back(score, *c);
       std::stable_sort(top.begin(), top.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
       if (top.size() > kRefined) top.pop_back();
     }
-    std::optional<Cylinder> refined;
-    size_t best_score = 0;
+    // Each of the best few, refined, is a spar when asSpar passes it; the one the most
+    // points then fit wins. (The best raw hypothesis can be a wrong one: on a
+    // mast crossed by three scan lines, fatter cylinders hold more of the lines at first
+    // and refine to nothing.)
+    std::optional<Candidate> best;
     for (const auto& [score, hypothesis] : top) {
-      if (score * stride < p.min_support / 2) continue;
+      // Refinement starts from the points within three bands: half a spar's worth there
+      // at least (a sparse scan's rough normals give hypotheses few points fit closely).
+      if (scoreOf(hypothesis, 3 * band) * stride < p.min_support / 2) continue;
       const Cylinder c = refineCylinder(pts, refineCylinder(pts, hypothesis, 3 * band), band);
-      if (!(c.radius >= p.min_radius_m && c.radius <= p.max_radius_m)) continue;
-      const size_t s2 = scoreOf(c);
-      if (s2 > best_score) {
-        best_score = s2;
-        refined = c;
-      }
+      const std::optional<Candidate> k = asSpar(pts, c, p);
+      if (k && (!best || k->on.size() > best->on.size())) best = k;
     }
-    if (!refined || best_score * stride < p.min_support) break;
-    const Cylinder c = *refined;
-    // A spar is round: its points span more of its girth than any flat strip could
-    // within the band, and at least min_arc_deg.
-    const double min_arc = std::max(p.min_arc_deg, 1.25 * flatStripArcDeg(c.radius, band));
-    std::vector<std::pair<double, double>> on;  // (along, angle) of the pool's points on its surface
-    double sum2 = 0;
-    for (const Vec3& x : pts) {
-      const double r = radialResidual(x, c);
-      if (std::abs(r) > band) continue;
-      const AxialPosition a = axialPosition(x, c);
-      on.emplace_back(a.along, a.angle);
-      sum2 += r * r;
-    }
-    if (on.size() < p.min_support || !(c.radius >= p.min_radius_m && c.radius <= p.max_radius_m)) break;
-    std::sort(on.begin(), on.end());
-    // The spar runs as far as its points do without a gap: out from the median, up to the
-    // last point before a gap of more than two diameters (an infinite cylinder also grazes
-    // whatever lies further along its line).
-    const double max_gap = 4 * c.radius + 2 * band;
-    size_t first = on.size() / 2, last = first;
-    while (first > 0 && on[first].first - on[first - 1].first <= max_gap) --first;
-    while (last + 1 < on.size() && on[last + 1].first - on[last].first <= max_gap) ++last;
+    if (!best) break;
+    const Cylinder c = best->cylinder;
+    const std::vector<std::pair<double, double>>& on = best->on;
+    const size_t first = best->first, last = best->last;
+    const double min_arc = best->min_arc, max_gap = best->max_gap;
     double lo = on[first].first, hi = on[last].first;
-    std::vector<double> angle;
-    for (size_t k = first; k <= last; ++k) angle.push_back(on[k].second);
-    if (hi - lo < p.min_length_radii * c.radius || spannedArcDeg(angle) < min_arc) break;
     // It runs on through the points of `length_from` on its surface (a sail cluster that
     // grew over the mast beside its luff) while each next two gaps' length of them starts
     // within a gap and spans 0.4 of the arc the spar had to: two fans of a turntable
@@ -365,7 +431,7 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
     SparFit fit;
     fit.found = true;
     fit.support = on.size();
-    fit.rms_m = std::sqrt(sum2 / static_cast<double>(on.size()));
+    fit.rms_m = best->rms_m;
     fit.spar.name = "spar " + std::to_string(s + 1);
     fit.spar.axis = c.axis;
     fit.spar.base = c.point + lo * c.axis;
