@@ -101,11 +101,21 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
   a.spars = found.spars;
   if (found.spars.empty()) return sail;
   const double sigma = p.sensor_sigma_m;
+  // Each spar as the search's run of points could have carried on: two diameters and two
+  // bands beyond each end. A point there on its surface is the spar's, though no run
+  // of them reached it (the sparse mast foot below the sail's tack).
+  std::vector<Spar> reach_of;
+  for (const SparFit& f : found.spars) {
+    Spar s = f.spar;
+    const double gap = 4 * s.radius_m + 4 * sigma;
+    s.base -= gap * s.axis;
+    s.length_m += 2 * gap;
+    reach_of.push_back(s);
+  }
   // Which spar is nearest x, and how far x lies off it.
   auto nearestSpar = [&](const Vec3& x) {
     std::pair<double, size_t> best{std::numeric_limits<double>::infinity(), 0};
-    for (size_t s = 0; s < found.spars.size(); ++s)
-      best = std::min(best, std::make_pair(distanceToSpar(x, found.spars[s].spar), s));
+    for (size_t s = 0; s < reach_of.size(); ++s) best = std::min(best, std::make_pair(distanceToSpar(x, reach_of[s]), s));
     return best;
   };
   // The unit direction across spar s from its axis to x.

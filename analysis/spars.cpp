@@ -313,6 +313,59 @@ std::optional<Candidate> asSpar(const std::vector<Vec3>& pts, const Cylinder& c,
   return k;
 }
 
+// Whether spar b lies on a's line: axes within 5°, radii within a quarter, and b's axis
+// within a radius of a's where the two are nearest (over their overlap along a's axis,
+// or at b's end facing a across a gap). A sparse stretch's axis can lean a degree off.
+bool onTheLineOf(const Spar& a, const Spar& b) {
+  const double cos_ab = a.axis.dot(b.axis);
+  if (std::abs(cos_ab) < std::cos(5.0 * M_PI / 180.0)) return false;
+  if (std::abs(a.radius_m - b.radius_m) > 0.25 * std::max(a.radius_m, b.radius_m)) return false;
+  const double b0 = (b.base - a.base).dot(a.axis), b1 = b0 + b.length_m * cos_ab;
+  const double lo = std::max(0.0, std::min(b0, b1)), hi = std::min(a.length_m, std::max(b0, b1));
+  // Where along a to compare: the overlap's middle, or the end of b facing a.
+  const double t = lo <= hi ? 0.5 * (lo + hi) : (std::max(b0, b1) < 0 ? std::max(b0, b1) : std::min(b0, b1));
+  const Vec3 on_b = b.base + ((t - b0) / cos_ab) * b.axis;
+  const Vec3 d = on_b - a.base;
+  return (d - d.dot(a.axis) * a.axis).norm() <= a.radius_m;
+}
+
+// One spar of a and b (b on a's line), each with the points on its surface: the
+// cylinder refitted on both sets of points from the better supported one's, running
+// over both and over the gap between.
+SparFit mergeSpars(const SparFit& a, const std::vector<Vec3>& a_points, const SparFit& b,
+                   const std::vector<Vec3>& b_points, double band) {
+  const SparFit& lead = a.support >= b.support ? a : b;
+  Cylinder c;
+  c.point = lead.spar.base;
+  c.axis = lead.spar.axis;
+  c.radius = lead.spar.radius_m;
+  std::vector<Vec3> both = a_points;
+  both.insert(both.end(), b_points.begin(), b_points.end());
+  c = refineCylinder(both, c, band);
+  SparFit m = a;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum2 = 0;
+  size_t n = 0;
+  for (const Spar* s : {&a.spar, &b.spar})
+    for (const Vec3& end : {s->base, Vec3(s->base + s->length_m * s->axis)}) {
+      const double along = (end - c.point).dot(c.axis);
+      lo = std::min(lo, along);
+      hi = std::max(hi, along);
+    }
+  for (const Vec3& x : both) {
+    const double r = radialResidual(x, c);
+    if (std::abs(r) > band) continue;
+    sum2 += r * r;
+    ++n;
+  }
+  m.spar.axis = c.axis;
+  m.spar.base = c.point + lo * c.axis;
+  m.spar.length_m = hi - lo;
+  m.spar.radius_m = c.radius;
+  m.support = n;
+  m.rms_m = n ? std::sqrt(sum2 / static_cast<double>(n)) : 0.0;
+  return m;
+}
+
 }  // namespace
 
 SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const std::vector<uint32_t>& candidates,
@@ -332,6 +385,7 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
   SparSearch out;
   const double band = 2 * p.sensor_sigma_m;
   std::vector<uint32_t> pool = candidates;
+  std::vector<std::vector<Vec3>> held;  // the points on each found spar's surface
   std::mt19937 rng(p.seed);
   for (int s = 0; s < p.max_spars && pool.size() >= std::max<size_t>(p.min_support, 2); ++s) {
     std::vector<Vec3> pts;
@@ -355,7 +409,9 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
     // Two points' normals give a rough cylinder (a few mm of noise in a normal
     // moves a thin spar's axis by centimetres): the best few hypotheses are each
     // refined on their points, and the one the most points then fit wins.
-    constexpr size_t kRefined = 6;
+    // Twelve: in a 3,000-point scene the mast's rough hypotheses ranked below fat cylinders
+    // through its flank and the luff beside it, and six left it out.
+    constexpr size_t kRefined = 12;
     std::vector<std::pair<size_t, Cylinder>> top;  // (score, hypothesis), best first
     for (int h = 0; h < p.hypotheses; ++h) {
       const size_t i = pick(rng);
@@ -432,12 +488,29 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
     fit.found = true;
     fit.support = on.size();
     fit.rms_m = best->rms_m;
-    fit.spar.name = "spar " + std::to_string(s + 1);
+    fit.spar.name = "spar " + std::to_string(out.spars.size() + 1);
     fit.spar.axis = c.axis;
     fit.spar.base = c.point + lo * c.axis;
     fit.spar.length_m = hi - lo;
     fit.spar.radius_m = c.radius;
-    out.spars.push_back(fit);
+    // A stretch on the line of a spar found before, at its radius, is more of that spar:
+    // its points had a gap (the sail or a spreader hid it, or a sparse scan missed it).
+    std::vector<Vec3> surface;  // its own points, within its length
+    for (const Vec3& x : pts)
+      if (std::abs(radialResidual(x, c)) <= band) {
+        const double along = axialPosition(x, c).along;
+        if (along >= lo && along <= hi) surface.push_back(x);
+      }
+    const auto earlier = std::find_if(out.spars.begin(), out.spars.end(),
+                                      [&](const SparFit& f) { return onTheLineOf(f.spar, fit.spar); });
+    if (earlier == out.spars.end()) {
+      out.spars.push_back(fit);
+      held.push_back(std::move(surface));
+    } else {
+      const size_t e = static_cast<size_t>(earlier - out.spars.begin());
+      *earlier = mergeSpars(*earlier, held[e], fit, surface, band);
+      held[e].insert(held[e].end(), surface.begin(), surface.end());
+    }
     // The next spar is searched among the points this one does not hold.
     std::vector<uint32_t> rest;
     for (size_t k = 0; k < pool.size(); ++k)

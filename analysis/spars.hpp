@@ -78,7 +78,8 @@ struct SparSearch {
 // near-copies left out, are refined by least squares on axis, direction and radius, and
 // the refined one most points fit among those that pass as a spar (support, length,
 // arc round the axis, not within the band of one plane) wins. Its points are taken
-// out and the next spar searched, up to max_spars. `normals` has one per cloud point.
+// out and the next spar searched, up to max_spars; a stretch found on the line of an
+// earlier spar at its radius joins it (refitted on both, over the gap between). `normals` has one per cloud point.
 // A found spar's length runs on through the points of `length_from` on its surface
 // (the sail cluster, which can have grown over the mast beside its luff) for as long as
 // they keep round it, two scan lines' worth of its girth at least; they are not

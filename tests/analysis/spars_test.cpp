@@ -175,6 +175,31 @@ TEST(FindSpars, ASparseMastAndBoomBesideALargeDeckAreEachFoundOnce) {
   }
 }
 
+TEST(FindSpars, AMastWithAGapInItsPointsIsOneSparOverTheGap) {
+  // A 70 mm mast seen from 0 to 3 m and from 3.8 to 9 m (a spreader's shadow, or a
+  // sparse scan's hole between): the search finds one stretch, then the other on the
+  // same line. They are one spar, over the gap, holding both stretches' points.
+  std::mt19937 rng(6);
+  Cloud c;
+  const Vec3 eye(-1.5, -6.0, 3.0), dir = Vec3(0.05, 0.0, 1.0).normalized();
+  pushVisibleSpar(c, Vec3::Zero(), dir, 3.0, 0.07, eye, 0.02, rng);
+  const size_t lower = c.size();
+  pushVisibleSpar(c, 3.8 * dir, dir, 5.2, 0.07, eye, 0.02, rng);
+  const NormalEstimation n = estimateNormals(c);
+  const SparSearch s = findSpars(c, n.normals.normals, everyIndex(c));
+  ASSERT_EQ(s.spars.size(), 1u);
+  const Spar& mast = s.spars[0].spar;
+  EXPECT_LT(angleDeg(mast.axis, dir), 1.0);
+  // From its foot to its top, to the 2 cm sampling.
+  const double foot = (mast.base).dot(dir), top = (mast.base + mast.length_m * mast.axis).dot(dir);
+  EXPECT_NEAR(std::min(foot, top), 0.0, 0.03);
+  EXPECT_NEAR(std::max(foot, top), 9.0, 0.03);
+  EXPECT_LT(distanceToSpar(3.4 * dir + 0.07 * Vec3::UnitX(), mast), kSigma) << "the gap is the spar's";
+  // Both stretches' points, nearly all of them within 2σ of the surface.
+  EXPECT_GT(s.spars[0].support, static_cast<size_t>(0.9 * static_cast<double>(c.size())));
+  EXPECT_GT(s.spars[0].support, c.size() - lower);
+}
+
 TEST(FindSpars, FlatAndGentlyCurvedSurfacesAreNoSpars) {
   std::mt19937 rng(5);
   Cloud c;
