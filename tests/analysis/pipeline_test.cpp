@@ -456,58 +456,71 @@ TEST(Pipeline, SceneWithMastBoomAndDeckIsSegmentedToTheSail) {
   expectNoisyTargets(a, design);
 }
 
-TEST(Pipeline, ASparseSquareTopInItsSceneFindsItsSparsAndKeepsItsCorners) {
-  // 3,000 and 5,000 samples on the square top, 9 and 7 cm apart, with its mast, boom and
-  // deck at that spacing. A normal there is fitted over neighbours half a metre across,
-  // rough on a 7 cm mast: 400 random pairs found 0-3 of the two spars in 12 runs at
-  // 5,000, the sail kept the mast's or boom's points, and 8 runs put a corner 20 cm to
-  // 6 m off. At 3,000 the mast came out in two stretches with its points between them
-  // left in the sail, or ended above its foot with one point below it left there.
+// The square top in its scene, `points` samples on the sail, seeds 1 to `seeds`, clean
+// and with σ noise: both spars found, the sail's cluster clean, corners within two sample
+// spacings and sections within half the noise targets of the sail analysed alone.
+void expectSparseSceneReadsAsTheSailAlone(size_t points, uint64_t seeds) {
   const SailDesign design = exampleDesign(SailType::SquareTopMain);
   const SailSurface truth(design);
   const double area = meshArea(generateSailMesh(design));
-  for (size_t points : {3000, 5000})
-    for (double noise : {0.0, kSigma})
-      for (uint64_t seed = 1; seed <= 6; ++seed) {
-        SCOPED_TRACE(std::to_string(points) + " points, seed " + std::to_string(seed) + ", noise " +
-                     std::to_string(noise));
-        const SceneCloud scene = sampleSailScene(design, scan(points, seed, noise));
-        const SailAnalysis a = analyzeSail(scene.cloud);
-        // The mast (70 mm, upright) and the boom (60 mm, about level), each from a few
-        // hundred points to σ.
-        ASSERT_EQ(a.spars.size(), 2u);
-        const bool mast_first = std::abs(a.spars[0].spar.axis.z()) > std::abs(a.spars[1].spar.axis.z());
-        const Spar& mast = a.spars[mast_first ? 0 : 1].spar;
-        const Spar& boom = a.spars[mast_first ? 1 : 0].spar;
-        EXPECT_NEAR(mast.radius_m, 0.07, kSigma);
-        EXPECT_NEAR(boom.radius_m, 0.06, kSigma);
-        EXPECT_GT(std::abs(mast.axis.z()), std::cos(10.0 * M_PI / 180.0));
-        EXPECT_LT(std::abs(boom.axis.z()), std::sin(10.0 * M_PI / 180.0));
-        // The sail's cluster: at least 98 % of its points, at most 1 % foreign.
-        const StageReport& seg = a.stages.front();
-        ASSERT_EQ(seg.name, "segmentation");
-        const double n = static_cast<double>(points);
-        EXPECT_LE(static_cast<double>(seg.points_out), 1.01 * n);
-        EXPECT_GE(static_cast<double>(seg.points_out), 0.98 * n);
-        // Corners within two sample spacings, as the sail alone (the sparse tips are
-        // rounded off over a few of them).
-        const double corner_m = 2 * std::sqrt(area / n);
-        ASSERT_TRUE(a.outline.has_peak);
-        EXPECT_LT((a.outline.tack - truth.tack()).norm(), corner_m);
-        EXPECT_LT((a.outline.clew - truth.clew()).norm(), corner_m);
-        EXPECT_LT((a.outline.head - truth.head()).norm(), corner_m);
-        EXPECT_LT((a.outline.peak - truth.peak()).norm(), corner_m);
-        // Its sections read as the sail's alone do, to half the noise targets: a fat
-        // cylinder through the mast and the luff beside it once took the luff's points
-        // and 0.25 % of the camber.
-        const SailAnalysis alone = analyzeSail(sampleSail(design, scan(points, seed, noise)));
-        ASSERT_EQ(a.sections.sections.size(), alone.sections.sections.size());
-        for (size_t i = 0; i < a.sections.sections.size(); ++i) {
-          const Section &in_scene = a.sections.sections[i], &by_itself = alone.sections.sections[i];
-          EXPECT_NEAR(in_scene.value.camber_pct, by_itself.value.camber_pct, 0.15) << "section " << i;
-          EXPECT_NEAR(in_scene.value.twist_deg, by_itself.value.twist_deg, 0.15) << "section " << i;
-        }
+  const double n = static_cast<double>(points);
+  for (double noise : {0.0, kSigma})
+    for (uint64_t seed = 1; seed <= seeds; ++seed) {
+      SCOPED_TRACE(std::to_string(points) + " points, seed " + std::to_string(seed) + ", noise " +
+                   std::to_string(noise));
+      const SceneCloud scene = sampleSailScene(design, scan(points, seed, noise));
+      const SailAnalysis a = analyzeSail(scene.cloud);
+      // The mast (70 mm, upright) and the boom (60 mm, about level), each from a few
+      // hundred points to σ.
+      ASSERT_EQ(a.spars.size(), 2u);
+      const bool mast_first = std::abs(a.spars[0].spar.axis.z()) > std::abs(a.spars[1].spar.axis.z());
+      const Spar& mast = a.spars[mast_first ? 0 : 1].spar;
+      const Spar& boom = a.spars[mast_first ? 1 : 0].spar;
+      EXPECT_NEAR(mast.radius_m, 0.07, kSigma);
+      EXPECT_NEAR(boom.radius_m, 0.06, kSigma);
+      EXPECT_GT(std::abs(mast.axis.z()), std::cos(10.0 * M_PI / 180.0));
+      EXPECT_LT(std::abs(boom.axis.z()), std::sin(10.0 * M_PI / 180.0));
+      // The sail's cluster: at least 98 % of its points, at most 1 % foreign.
+      const StageReport& seg = a.stages.front();
+      ASSERT_EQ(seg.name, "segmentation");
+      EXPECT_LE(static_cast<double>(seg.points_out), 1.01 * n);
+      EXPECT_GE(static_cast<double>(seg.points_out), 0.98 * n);
+      // Corners within two sample spacings, as the sail alone (the sparse tips are
+      // rounded off over a few of them).
+      const double corner_m = 2 * std::sqrt(area / n);
+      ASSERT_TRUE(a.outline.has_peak);
+      EXPECT_LT((a.outline.tack - truth.tack()).norm(), corner_m);
+      EXPECT_LT((a.outline.clew - truth.clew()).norm(), corner_m);
+      EXPECT_LT((a.outline.head - truth.head()).norm(), corner_m);
+      EXPECT_LT((a.outline.peak - truth.peak()).norm(), corner_m);
+      // Its sections read as the sail's alone do, to half the noise targets: a fat
+      // cylinder through the mast and the luff beside it once took the luff's points
+      // and 0.25 % of the camber.
+      const SailAnalysis alone = analyzeSail(sampleSail(design, scan(points, seed, noise)));
+      ASSERT_EQ(a.sections.sections.size(), alone.sections.sections.size());
+      for (size_t i = 0; i < a.sections.sections.size(); ++i) {
+        const Section &in_scene = a.sections.sections[i], &by_itself = alone.sections.sections[i];
+        EXPECT_NEAR(in_scene.value.camber_pct, by_itself.value.camber_pct, 0.15) << "section " << i;
+        EXPECT_NEAR(in_scene.value.twist_deg, by_itself.value.twist_deg, 0.15) << "section " << i;
       }
+    }
+}
+
+TEST(Pipeline, ASparseSquareTopInItsSceneFindsItsSparsAndKeepsItsCorners) {
+  // 5,000 samples on the square top, 7 cm apart, with its mast, boom and deck at that
+  // spacing. A normal there is fitted over neighbours half a metre across, rough on a
+  // 7 cm mast: 400 random pairs found 0-3 of the two spars in 12 runs, the sail kept the
+  // mast's or boom's points, and 8 runs put a corner 20 cm to 6 m off.
+  expectSparseSceneReadsAsTheSailAlone(5000, 6);
+}
+
+TEST(Pipeline, AVerySparseSquareTopInItsSceneFindsItsSparsAndKeepsItsCorners) {
+  // 3,000 samples, 9 cm apart. The mast came out in two stretches with its points
+  // between them left in the sail; or ended above its foot, one point below it left
+  // there; or was found only above 4-8 m, because its rough hypotheses refined to a
+  // metre of it, and its samples round its girth, one every 16°, were not taken to go
+  // round it.
+  expectSparseSceneReadsAsTheSailAlone(3000, 18);
 }
 
 TEST(Pipeline, AFlatMainsailInItsSceneIsFound) {
