@@ -107,7 +107,7 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
   std::vector<Spar> reach_of;
   for (const SparFit& f : found.spars) {
     Spar s = f.spar;
-    const double gap = 4 * s.radius_m + 4 * sigma;
+    const double gap = sparRunGapM(s.radius_m, sigma);
     s.base -= gap * s.axis;
     s.length_m += 2 * gap;
     reach_of.push_back(s);
@@ -121,8 +121,7 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
   // The unit direction across spar s from its axis to x.
   auto across = [&](const Vec3& x, size_t s) {
     const Spar& spar = found.spars[s].spar;
-    const Vec3 d = x - spar.base;
-    return (d - d.dot(spar.axis) * spar.axis).normalized();
+    return acrossAxis(x - spar.base, spar.axis).normalized();
   };
   std::vector<char> loose(cloud.size(), 0);
   for (uint32_t i : seg.unassigned) loose[i] = !in_sail[i];

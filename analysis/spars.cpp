@@ -6,17 +6,21 @@
 #include <limits>
 #include <optional>
 #include <random>
-
-#include <Eigen/Eigenvalues>
+#include <tuple>
 
 #include "analysis/errors.hpp"
 #include "analysis/neighbours.hpp"
+#include "analysis/principal_axes.hpp"
 
 namespace sailshape {
 
+Vec3 acrossAxis(const Vec3& d, const Vec3& axis) { return d - d.dot(axis) * axis; }
+
+double sparRunGapM(double radius_m, double sensor_sigma_m) { return 4 * radius_m + 4 * sensor_sigma_m; }
+
 double distanceToSpar(const Vec3& p, const Spar& s) {
   const double along = (p - s.base).dot(s.axis);
-  const double radial = (p - s.base - along * s.axis).norm() - s.radius_m;
+  const double radial = acrossAxis(p - s.base, s.axis).norm() - s.radius_m;
   return std::max({radial, along - s.length_m, -along});
 }
 
@@ -117,7 +121,7 @@ struct Cylinder {
 
 double radialResidual(const Vec3& p, const Cylinder& c) {
   const Vec3 d = p - c.point;
-  return (d - d.dot(c.axis) * c.axis).norm() - c.radius;
+  return acrossAxis(d, c.axis).norm() - c.radius;
 }
 
 // The cylinder through two surface points with their normals: the axis is
@@ -145,14 +149,17 @@ std::optional<Cylinder> cylinderThrough(const Vec3& p1, const Vec3& n1, const Ve
   return c;
 }
 
-// Whether two cylinders are near-copies: axes within 5°, radii within a quarter, and
-// each axis within half the radius of the other's.
+// Whether two round surfaces could be one: axes within 5° and radii within a quarter.
+bool parallelAndAsThick(const Vec3& axis_a, double radius_a, const Vec3& axis_b, double radius_b) {
+  return std::abs(axis_a.dot(axis_b)) >= std::cos(5.0 * M_PI / 180.0) &&
+         std::abs(radius_a - radius_b) <= 0.25 * std::max(radius_a, radius_b);
+}
+
+// Whether two cylinders are near-copies: parallel and as thick, and each axis within
+// half the radius of the other's.
 bool alike(const Cylinder& a, const Cylinder& b) {
-  if (std::abs(a.axis.dot(b.axis)) < std::cos(5.0 * M_PI / 180.0)) return false;
-  const double r = std::max(a.radius, b.radius);
-  if (std::abs(a.radius - b.radius) > 0.25 * r) return false;
-  const Vec3 d = b.point - a.point;
-  return (d - d.dot(a.axis) * a.axis).norm() <= 0.5 * r;
+  return parallelAndAsThick(a.axis, a.radius, b.axis, b.radius) &&
+         acrossAxis(b.point - a.point, a.axis).norm() <= 0.5 * std::max(a.radius, b.radius);
 }
 
 // Along-axis position and angle around the axis of p.
@@ -270,27 +277,31 @@ Cylinder refineCylinder(const std::vector<Vec3>& pts, Cylinder c, double band) {
 }
 
 
+// The arc round a spar of `radius` its points must span: min_arc_deg, and a quarter more
+// than a flat strip could lie within the band at that radius.
+double minArcDeg(double radius, const SparSearchParams& p) {
+  return std::max(p.min_arc_deg, 1.25 * flatStripArcDeg(radius, 2 * p.sensor_sigma_m));
+}
+
 // A refined cylinder that passed as a spar: its points on the surface as (along, angle)
-// sorted along, the run [first, last] of them without a gap, and the tests' limits.
+// sorted along, with their indices into the searched points, and the run [first, last]
+// of them without a gap.
 struct Candidate {
   Cylinder cylinder;
   std::vector<std::pair<double, double>> on;
+  std::vector<uint32_t> index;
   size_t first = 0, last = 0;
-  double min_arc = 0, max_gap = 0, rms_m = 0;
+  double rms_m = 0;
 };
 
-// The fraction of `pts` within `band` of their least-squares plane.
-double fractionOnPlane(const std::vector<Vec3>& pts, double band) {
-  if (pts.size() < 3) return 1.0;
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& x : pts) mean += x;
-  mean /= static_cast<double>(pts.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Vec3& x : pts) cov += (x - mean) * (x - mean).transpose();
-  const Vec3 normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+// The fraction of points[indices] within `band` of their least-squares plane.
+double fractionOnPlane(const std::vector<Vec3>& points, const std::vector<uint32_t>& indices, double band) {
+  if (indices.size() < 3) return 1.0;
+  const PrincipalAxes pa = principalAxes(points, indices);
+  const Vec3 normal = pa.axes.col(0);
   size_t in = 0;
-  for (const Vec3& x : pts) in += std::abs((x - mean).dot(normal)) <= band;
-  return static_cast<double>(in) / static_cast<double>(pts.size());
+  for (uint32_t i : indices) in += std::abs((points[i] - pa.mean).dot(normal)) <= band;
+  return static_cast<double>(in) / static_cast<double>(indices.size());
 }
 
 // Whether the cylinder is a spar among `pts`: within the radius limits, with at least
@@ -304,35 +315,42 @@ std::optional<Candidate> asSpar(const std::vector<Vec3>& pts, const Cylinder& c,
   if (!(c.radius >= p.min_radius_m && c.radius <= p.max_radius_m)) return std::nullopt;
   Candidate k;
   k.cylinder = c;
-  std::vector<std::pair<double, size_t>> order;  // (along, index into pts) on the surface
+  struct OnSurface {
+    double along, angle;
+    uint32_t index;
+    bool operator<(const OnSurface& o) const { return std::tie(along, index) < std::tie(o.along, o.index); }
+  };
+  std::vector<OnSurface> on;
   double sum2 = 0;
   for (size_t i = 0; i < pts.size(); ++i) {
     const double r = radialResidual(pts[i], c);
     if (std::abs(r) > band) continue;
-    order.emplace_back(axialPosition(pts[i], c).along, i);
+    const AxialPosition a = axialPosition(pts[i], c);
+    on.push_back({a.along, a.angle, static_cast<uint32_t>(i)});
     sum2 += r * r;
   }
-  if (order.size() < p.min_support) return std::nullopt;
-  std::sort(order.begin(), order.end());
-  for (const auto& [along, i] : order) k.on.emplace_back(along, axialPosition(pts[i], c).angle);
+  if (on.size() < p.min_support) return std::nullopt;
+  std::sort(on.begin(), on.end());
+  for (const OnSurface& o : on) {
+    k.on.emplace_back(o.along, o.angle);
+    k.index.push_back(o.index);
+  }
   k.rms_m = std::sqrt(sum2 / static_cast<double>(k.on.size()));
   // The spar runs as far as its points do without a gap: out from the median, up to the
   // last point before a gap of more than two diameters (an infinite cylinder also grazes
   // whatever lies further along its line).
-  k.max_gap = 4 * c.radius + 2 * band;
+  const double max_gap = sparRunGapM(c.radius, p.sensor_sigma_m);
   k.first = k.last = k.on.size() / 2;
-  while (k.first > 0 && k.on[k.first].first - k.on[k.first - 1].first <= k.max_gap) --k.first;
-  while (k.last + 1 < k.on.size() && k.on[k.last + 1].first - k.on[k.last].first <= k.max_gap) ++k.last;
+  while (k.first > 0 && k.on[k.first].first - k.on[k.first - 1].first <= max_gap) --k.first;
+  while (k.last + 1 < k.on.size() && k.on[k.last + 1].first - k.on[k.last].first <= max_gap) ++k.last;
   if (k.on[k.last].first - k.on[k.first].first < p.min_length_radii * c.radius) return std::nullopt;
   // A spar is round: its points span more of its girth than any flat strip could.
-  k.min_arc = std::max(p.min_arc_deg, 1.25 * flatStripArcDeg(c.radius, band));
   std::vector<double> angle;
   for (size_t i = k.first; i <= k.last; ++i) angle.push_back(k.on[i].second);
-  if (spannedArcDeg(angle) < k.min_arc) return std::nullopt;
-  std::vector<Vec3> run;
-  run.reserve(k.last - k.first + 1);
-  for (size_t i = k.first; i <= k.last; ++i) run.push_back(pts[order[i].second]);
-  if (fractionOnPlane(run, band) >= 0.9) return std::nullopt;
+  if (spannedArcDeg(angle) < minArcDeg(c.radius, p)) return std::nullopt;
+  const std::vector<uint32_t> run(k.index.begin() + static_cast<long>(k.first),
+                                  k.index.begin() + static_cast<long>(k.last) + 1);
+  if (fractionOnPlane(pts, run, band) >= 0.9) return std::nullopt;
   return k;
 }
 
@@ -340,16 +358,14 @@ std::optional<Candidate> asSpar(const std::vector<Vec3>& pts, const Cylinder& c,
 // within a radius of a's where the two are nearest (over their overlap along a's axis,
 // or at b's end facing a across a gap). A sparse stretch's axis can lean a degree off.
 bool onTheLineOf(const Spar& a, const Spar& b) {
+  if (!parallelAndAsThick(a.axis, a.radius_m, b.axis, b.radius_m)) return false;
   const double cos_ab = a.axis.dot(b.axis);
-  if (std::abs(cos_ab) < std::cos(5.0 * M_PI / 180.0)) return false;
-  if (std::abs(a.radius_m - b.radius_m) > 0.25 * std::max(a.radius_m, b.radius_m)) return false;
   const double b0 = (b.base - a.base).dot(a.axis), b1 = b0 + b.length_m * cos_ab;
   const double lo = std::max(0.0, std::min(b0, b1)), hi = std::min(a.length_m, std::max(b0, b1));
   // Where along a to compare: the overlap's middle, or the end of b facing a.
   const double t = lo <= hi ? 0.5 * (lo + hi) : (std::max(b0, b1) < 0 ? std::max(b0, b1) : std::min(b0, b1));
   const Vec3 on_b = b.base + ((t - b0) / cos_ab) * b.axis;
-  const Vec3 d = on_b - a.base;
-  return (d - d.dot(a.axis) * a.axis).norm() <= a.radius_m;
+  return acrossAxis(on_b - a.base, a.axis).norm() <= a.radius_m;
 }
 
 // One spar of a and b (b on a's line), each with the points on its surface: the
@@ -474,7 +490,7 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
     const Cylinder c = best->cylinder;
     const std::vector<std::pair<double, double>>& on = best->on;
     const size_t first = best->first, last = best->last;
-    const double min_arc = best->min_arc, max_gap = best->max_gap;
+    const double min_arc = minArcDeg(c.radius, p), max_gap = sparRunGapM(c.radius, p.sensor_sigma_m);
     double lo = on[first].first, hi = on[last].first;
     // It runs on through the points of `length_from` on its surface (a sail cluster that
     // grew over the mast beside its luff) while each next two gaps' length of them starts
@@ -519,11 +535,8 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
     // A stretch on the line of a spar found before, at its radius, is more of that spar:
     // its points had a gap (the sail or a spreader hid it, or a sparse scan missed it).
     std::vector<Vec3> surface;  // its own points, within its length
-    for (const Vec3& x : pts)
-      if (std::abs(radialResidual(x, c)) <= band) {
-        const double along = axialPosition(x, c).along;
-        if (along >= lo && along <= hi) surface.push_back(x);
-      }
+    for (size_t k = 0; k < on.size(); ++k)
+      if (on[k].first >= lo && on[k].first <= hi) surface.push_back(pts[best->index[k]]);
     const auto earlier = std::find_if(out.spars.begin(), out.spars.end(),
                                       [&](const SparFit& f) { return onTheLineOf(f.spar, fit.spar); });
     if (earlier == out.spars.end()) {

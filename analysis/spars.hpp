@@ -45,6 +45,14 @@ SparFit fitSpar(const Cloud& cloud, const Spar& nominal, const SparFitParams& pa
 // every side, the flat ends included.
 double distanceToSpar(const Vec3& p, const Spar& spar);
 
+// The part of offset d across the unit `axis`: its perpendicular off the axis line.
+Vec3 acrossAxis(const Vec3& d, const Vec3& axis);
+
+// The longest gap along a spar of `radius_m` its points may leave and still be one run
+// of them (two diameters and two bands): the search ends a spar at a wider one, and the
+// pipeline gives a spar this much reach beyond its ends.
+double sparRunGapM(double radius_m, double sensor_sigma_m);
+
 // Finding spars nobody gave a place for: in a scene analysed without the rig's
 // measurements, the mast 2 cm forward of the luff mixes into the neighbourhoods of
 // the sail's luff strip; knowing the mast's round surface lets that strip come back
@@ -79,7 +87,8 @@ struct SparSearch {
 // the refined one most points fit among those that pass as a spar (support, length,
 // arc round the axis, not within the band of one plane) wins. Its points are taken
 // out and the next spar searched, up to max_spars; a stretch found on the line of an
-// earlier spar at its radius joins it (refitted on both, over the gap between). `normals` has one per cloud point.
+// earlier spar at its radius joins it (refitted on both, over the gap between).
+// `normals` has one per cloud point.
 // A found spar's length runs on through the points of `length_from` on its surface
 // (the sail cluster, which can have grown over the mast beside its luff) for as long as
 // they keep round it, two scan lines' worth of its girth at least; they are not
