@@ -288,6 +288,31 @@ Frontier frontierRecess(std::vector<std::pair<double, double>> along_offset, dou
   return f;
 }
 
+// The samples of a surface near its boundary: the mesh's vertices, their
+// normals and a grid over them.
+struct Samples {
+  const Mesh& mesh;
+  const std::vector<Vec3>& normals;
+  const PointGrid& tree;
+};
+
+// The direction into the surface across an edge through `at` with unit tangent
+// t: the mean normal of the 24 vertices nearest `near` × t, turned towards their
+// centroid. (Unit to within how far t leaves the surface.)
+Vec3 inwardAt(const Vec3& near, const Vec3& at, const Vec3& t, const Samples& smp, std::vector<uint32_t>& idx,
+              std::vector<double>& d2) {
+  smp.tree.nearest(near, 24, idx, d2);
+  Vec3 n = Vec3::Zero(), centre = Vec3::Zero();
+  for (uint32_t v : idx) {
+    n += smp.normals[v];
+    centre += smp.mesh.vertices[v];
+  }
+  centre /= static_cast<double>(idx.size());
+  Vec3 in = n.normalized().cross(t);
+  if (in.dot(centre - at) < 0) in = -in;
+  return in;
+}
+
 // A sampled surface's boundary lies inside the true edge: the outermost samples
 // sit some distance in. Sample offsets from the true edge are uniform on
 // [0, ∞), so within the strip o ≤ D of the found edge (offset o from it,
@@ -295,7 +320,9 @@ Frontier frontierRecess(std::vector<std::pair<double, double>> along_offset, dou
 // outermost samples of each stretch of the edge (frontierRecess), or, on an edge
 // too short for that, from δ = D − 2·mean(o); the edge's points are moved out by
 // it and the curve is fitted again.
-void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const PointGrid& tree, double spacing) {
+void fitEdge(Edge& e, const Samples& smp, double spacing) {
+  const Mesh& mesh = smp.mesh;
+  const PointGrid& tree = smp.tree;
   e.length = e.s.back();
   e.exclude = std::max(0.03 * e.length, 6.0 * spacing);
   std::vector<size_t> inner;
@@ -325,17 +352,7 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
   std::vector<Vec3> inward(e.points.size());
   for (size_t i = 0; i < e.points.size(); ++i) {
     const double si = std::clamp(e.s[i], e.exclude, e.length - e.exclude);
-    const Vec3 c = e.curve.at(si);
-    tree.nearest(e.points[i], 24, idx, d2);
-    Vec3 n = Vec3::Zero(), centre = Vec3::Zero();
-    for (uint32_t v : idx) {
-      n += normals[v];
-      centre += mesh.vertices[v];
-    }
-    centre /= static_cast<double>(idx.size());
-    Vec3 in = n.normalized().cross(e.curve.tangent(si));
-    if (in.dot(centre - c) < 0) in = -in;
-    inward[i] = in;
+    inward[i] = inwardAt(e.points[i], e.curve.at(si), e.curve.tangent(si), smp, idx, d2);
   }
 
 
@@ -419,6 +436,8 @@ void fitEdge(Edge& e, const Mesh& mesh, const std::vector<Vec3>& normals, const 
 struct CornerCurve {
   EdgeCurve curve;
   double sigma_at_corner = 0;  // m
+  double from = 0, to = 0;     // the distances from the corner it was fitted over, m
+  bool on_frontier = false;    // placed by the outermost samples beside it (ontoFrontier)
 };
 
 // The curve reaches max(60 boundary spacings, 5 % of the edge) from the corner.
@@ -479,10 +498,116 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
   }
   CornerCurve c;
   c.curve = f.curve;
+  c.from = *std::min_element(f.d.begin(), f.d.end());
+  c.to = *std::max_element(f.d.begin(), f.d.end());
   // A least-squares polynomial of degree q over evenly spread points is known at
   // the end of its range to about σ_res·(q + 1)/√N; the corner lies just beyond.
   c.sigma_at_corner = f.sigma_res * (f.used + 1) / std::sqrt(static_cast<double>(f.pts.size()));
   return c;
+}
+
+// A corner curve fitted through the boundary vertices carries their scatter (a
+// gap each: about a centimetre on a 40,000-point gennaker), and fitted over 60
+// boundary spacings it cannot follow how an edge bends on the last few metres
+// to a narrow head. Extrapolated to the corner, either moves the edges'
+// crossing by several times as much along the bisector: 2-5 cm there.
+//
+// The outermost of the many samples beside the edge place it far more sharply.
+// In each window along the curve, the samples' offsets o from it (positive
+// inwards) are uniform on [−δ, D], and the least of n lies a gap (D + δ)/(n + 1)
+// beyond −δ on average (as frontierRecess): δ is known to about that gap, a few
+// millimetres. Near a narrow corner D is cut to half the sail's width there,
+// where the other edge's samples begin. The frontier points so found take a
+// quadratic or a cubic over the first m windows; each candidate is known at the
+// corner to s·√(x₀ᵀ(AᵀA)⁻¹x₀) (x₀ the corner's powers, s the points' scatter:
+// the least-squares prediction there). Of the candidates that fit their points
+// as closely as those scatter, the one known best at the corner wins; if none
+// does, the one whose misfit costs least. The points' own scatter comes from
+// the second differences of their offsets, in which a smooth bend cancels and
+// noise adds 6σ² (median-based, so a stray window counts little).
+CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const Samples& smp, double spacing) {
+  const double window = 5.0 * spacing, strip = 4.0 * spacing;
+  std::vector<uint32_t> idx, near;
+  std::vector<double> d2, near_d2;
+  std::vector<double> centre, delta;
+  std::vector<Vec3> frontier;
+  for (double dw = c.from + 0.5 * window; dw + 0.5 * window <= c.to; dw += window) {
+    const Vec3 p = c.curve.at(dw), t = c.curve.tangent(dw);
+    const Vec3 in = inwardAt(p, p, t, smp, near, near_d2);
+    // Half the sail's width here: how far in the other edge's curve passes.
+    double across = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= 60; ++i) {
+      const Vec3 q = other.curve.at(3.0 * dw * i / 60.0) - p;
+      if (std::abs(q.dot(t)) <= 0.5 * window) across = std::min(across, q.dot(in));
+    }
+    const double D = std::min(strip, 0.5 * across);
+    if (!(D > 0.5 * spacing)) continue;
+    smp.tree.withinRadius(p, std::hypot(D + strip, 0.5 * window), idx, d2);
+    double least = std::numeric_limits<double>::infinity();
+    size_t n = 0;
+    for (uint32_t v : idx) {
+      const double along = (smp.mesh.vertices[v] - p).dot(t);
+      if (std::abs(along) > 0.5 * window) continue;
+      const double o = (smp.mesh.vertices[v] - c.curve.at(dw + along)).dot(in);
+      if (o > D || o < -strip) continue;
+      least = std::min(least, o);
+      ++n;
+    }
+    if (n < 8) continue;
+    // −least = δ − gap + E[gap], E[gap] = (D + δ)/(n + 1): solved for δ.
+    const double q = 1.0 / (static_cast<double>(n) + 1.0);
+    centre.push_back(dw);
+    delta.push_back((q * D - least) / (1.0 - q));
+    frontier.push_back(p - delta.back() * in);
+  }
+  constexpr size_t kFewest = 6;  // a quadratic and three degrees of freedom
+  if (centre.size() < kFewest) return c;
+  std::vector<double> bends;
+  for (size_t j = 2; j < delta.size(); ++j) bends.push_back(std::abs(delta[j] - 2.0 * delta[j - 1] + delta[j - 2]));
+  std::nth_element(bends.begin(), bends.begin() + static_cast<long>(bends.size() / 2), bends.end());
+  const double scatter = 1.4826 * bends[bends.size() / 2] / std::sqrt(6.0);
+
+  struct Candidate {
+    CornerCurve curve;
+    double sigma = 0;
+    bool fits = false;
+  };
+  auto fitOver = [&](size_t m, int degree) {
+    const std::vector<Vec3> pts(frontier.begin(), frontier.begin() + static_cast<long>(m));
+    const std::vector<double> ds(centre.begin(), centre.begin() + static_cast<long>(m));
+    Candidate k;
+    k.curve.curve = fitEdgeCurve(pts, ds, degree);
+    const EdgeCurve& f = k.curve.curve;
+    double res2 = 0;
+    Eigen::MatrixXd A(static_cast<Eigen::Index>(m), degree + 1);
+    Eigen::VectorXd x0(degree + 1);
+    for (size_t j = 0; j < m; ++j) {
+      res2 += (pts[j] - f.at(ds[j])).squaredNorm();
+      for (int e = 0; e <= degree; ++e) A(static_cast<Eigen::Index>(j), e) = std::pow((ds[j] - f.mid) / f.half, e);
+    }
+    for (int e = 0; e <= degree; ++e) x0[e] = std::pow(-f.mid / f.half, e);
+    const double dof = static_cast<double>(m) - degree - 1;
+    const double rms = std::sqrt(res2 / dof);
+    const double limit = scatter * (1.0 + 2.0 / std::sqrt(2.0 * dof));  // RMS spreads by 1/√(2 dof)
+    const double lever = std::sqrt(x0.dot((A.transpose() * A).ldlt().solve(x0)));
+    k.fits = rms <= limit;
+    k.sigma = lever * std::max(rms, scatter) * (k.fits ? 1.0 : rms / std::max(limit, 1e-12));
+    k.curve.sigma_at_corner = k.sigma;
+    k.curve.from = ds.front();
+    k.curve.to = ds.back();
+    k.curve.on_frontier = true;
+    return k;
+  };
+  std::optional<Candidate> best;
+  for (size_t m = centre.size();; m = std::max(kFewest, m * 4 / 5)) {
+    for (int degree : {2, 3}) {
+      if (m < 2 * static_cast<size_t>(degree + 1)) continue;
+      const Candidate k = fitOver(m, degree);
+      if (!best || (k.fits && !best->fits) || (k.fits == best->fits && k.sigma < best->sigma)) best = k;
+    }
+    if (m == kFewest) break;
+  }
+  return best->curve;
 }
 
 // Where two edges meet, and how they arrive there.
@@ -499,8 +624,9 @@ struct Meeting {
 
 // The closest pair of points of the two edges' corner curves (quadratics in the
 // distance from the corner, extrapolated back to it). Corners of 60° and wider
-// (a tack, a clew, a square head) let their curves shorten where an edge bends.
-Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing) {
+// (a tack, a clew, a square head) let their curves shorten where an edge bends;
+// narrower ones (a head) move their curves onto the samples' frontier.
+Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing, const Samples& smp) {
   const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
   auto closest = [&](const CornerCurve& ca, const CornerCurve& cb) {
     double best = std::numeric_limits<double>::infinity(), sa = 0, sb = 0;
@@ -529,8 +655,12 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
   if (angleAt(ca, sa, cb, sb) >= kPi / 3.0) {
     ca = cornerCurve(a, a_start, spacing, 2, true);
     cb = cornerCurve(b, b_start, spacing, 2, true);
-    std::tie(sa, sb) = closest(ca, cb);
+  } else {
+    const CornerCurve fa = ontoFrontier(ca, cb, smp, spacing), fb = ontoFrontier(cb, ca, smp, spacing);
+    ca = fa;
+    cb = fb;
   }
+  std::tie(sa, sb) = closest(ca, cb);
   Meeting m;
   m.point = 0.5 * (ca.curve.at(sa) + cb.curve.at(sb));
   // Directions into the sail along each edge (increasing distance from the corner).
@@ -541,12 +671,15 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
   // Shifting the two edges sideways by ε_a and ε_b moves their crossing along
   // the bisector by (ε_a + ε_b) / (2 sin(angle / 2)).
   const double half = std::max(0.5 * m.angle_rad, 1e-3);
-  // Each edge's sideways uncertainty at the corner: its corner curve's, the whole
-  // edge's, and half its recess: the edge was moved out by its recess averaged
-  // along it, and where the sail narrows to a corner the samples thin out
-  // differently, so how far the edge lies beyond them there is known only roughly.
-  const double side_a = std::hypot(ca.sigma_at_corner, a.sigma, 0.5 * a.recess);
-  const double side_b = std::hypot(cb.sigma_at_corner, b.sigma, 0.5 * b.recess);
+  // Each edge's sideways uncertainty at the corner: a frontier curve's own; else
+  // its corner curve's, the whole edge's, and half its recess: the edge was moved
+  // out by its recess averaged along it, and where the sail narrows to a corner
+  // the samples thin out differently, so how far the edge lies beyond them there
+  // is known only roughly.
+  auto side = [](const CornerCurve& c, const Edge& e) {
+    return c.on_frontier ? c.sigma_at_corner : std::hypot(c.sigma_at_corner, e.sigma, 0.5 * e.recess);
+  };
+  const double side_a = side(ca, a), side_b = side(cb, b);
   m.sigma_along_m = std::hypot(side_a, side_b) / (2.0 * std::sin(half));
   const Vec3 across_a = tb - tb.dot(ta) * ta, across_b = ta - ta.dot(tb) * tb;
   if (across_a.norm() > 1e-9 && across_b.norm() > 1e-9) {
@@ -859,12 +992,13 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   const std::vector<Vec3> normals = vertexNormals(mesh);
   // Cells about three boundary spacings wide: the 24 nearest vertices of a boundary point lie within two or so.
   const PointGrid tree(mesh.vertices, 3.0 * std::max(out.boundary_spacing_m, 1e-6));
+  const Samples samples{mesh, normals, tree};
   auto makeEdge = [&](size_t from, size_t to) {
     Edge e;
     e.points = edge(from, to);
     e.s.assign(e.points.size(), 0.0);
     for (size_t i = 1; i < e.points.size(); ++i) e.s[i] = e.s[i - 1] + (e.points[i] - e.points[i - 1]).norm();
-    fitEdge(e, mesh, normals, tree, out.boundary_spacing_m);
+    fitEdge(e, samples, out.boundary_spacing_m);
     return e;
   };
   const Edge luff = makeEdge(tack, head), foot = makeEdge(tack, clew);
@@ -876,7 +1010,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   const double density = static_cast<double>(mesh.vertices.size()) / std::max(1e-12, mesh_area);
   const double reach = std::max(0.05 * total, 10.0 * sp);
   auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start) {
-    const Vec3 c = placeCorner(meetEdges(a, a_start, b, b_start, sp), mesh, tree, loose_points, density, reach, sp);
+    const Vec3 c = placeCorner(meetEdges(a, a_start, b, b_start, sp, samples), mesh, tree, loose_points, density, reach, sp);
     return ontoSurface(c, mesh, tree, sp);
   };
   out.tack = corner(luff, true, foot, true);

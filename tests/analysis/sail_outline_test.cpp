@@ -175,17 +175,24 @@ TEST(SailOutline, ANotchCutIntoAnEdgeIsNoCorner) {
   for (double t : o.corner_turn_deg) EXPECT_GT(t, 0.0);
 }
 
-// A mainsail's head whose last samples stand apart: every sample within 12 cm
+// The example main sampled at 40,000 points, every sample within `radius` of its
+// head but the nearest gone.
+constexpr size_t kBareHeadSamples = 40'000;
+LoneTip mainWithABareHead(double radius) {
+  ScanSimulation sim;
+  sim.points = kBareHeadSamples;
+  sim.seed = 5;
+  return isolateTip(sampleSail(exampleDesign(SailType::Main), sim), SailSurface(exampleDesign(SailType::Main)).head(),
+                    radius);
+}
+
+// A mainsail's head whose last samples stand apart: every sample within 50 cm
 // of the head but the one nearest it is gone, and that one is not in the mesh
 // (as when the surface's long-edge trimming leaves a lone tip sample out).
 TEST(SailOutline, AHeadReachesTheLooseSampleTheMeshLeftOut) {
-  const SailDesign design = exampleDesign(SailType::Main);
-  const SailSurface truth(design);
-  ScanSimulation sim;
-  sim.points = 40'000;
-  sim.seed = 5;
+  const SailSurface truth(exampleDesign(SailType::Main));
   const Vec3 head = truth.head();
-  const LoneTip cut = isolateTip(sampleSail(design, sim), head, 0.12);
+  const LoneTip cut = mainWithABareHead(0.50);
   ASSERT_LT(cut.tip_distance_m, 0.05) << "the sampling left no sample near the head";
   const Vec3& tip = cut.tip;
   const Cloud& kept = cut.rest;
@@ -198,7 +205,7 @@ TEST(SailOutline, AHeadReachesTheLooseSampleTheMeshLeftOut) {
   const Vec3 up = (head - 0.5 * (truth.luffPoint(0.98) + truth.leechPoint(0.98))).normalized();
   EXPECT_GE((with.head - tip).dot(up), -0.002) << "head " << with.head.transpose() << ", tip " << tip.transpose();
   EXPECT_LT((with.head - head).norm(), 0.03);
-  // Without it the head stops short of the sample: the mesh ends 12 cm below the head.
+  // Without it the head stops short of the sample: the mesh ends 50 cm below the head.
   EXPECT_LT((without.head - tip).dot(up), -0.005);
 
   // A point beyond the luff, or off the surface, is no sample of this sail's tip.
@@ -208,6 +215,18 @@ TEST(SailOutline, AHeadReachesTheLooseSampleTheMeshLeftOut) {
     const SailOutline o = extractOutline(mesh, {}, {stray});
     EXPECT_LT((o.head - without.head).norm(), 1e-9) << "stray " << stray.transpose();
   }
+}
+
+// The same head with its last 12 cm bare and no lone sample at all: the luff and
+// leech, placed by the outermost samples beside them and carried on to where
+// they cross, put the head within half a sample spacing of the true one. (Their
+// corner curves fitted through the boundary vertices alone stopped 2.4 cm or more
+// short of it here.)
+TEST(SailOutline, AHeadWithItsLastSamplesGoneIsPlacedWhereItsEdgesCross) {
+  const SailDesign design = exampleDesign(SailType::Main);
+  const SailOutline o = extractOutline(reconstructSurface(mainWithABareHead(0.12).rest).mesh);
+  const double spacing = std::sqrt(meshArea(generateSailMesh(design, 200, 100)) / static_cast<double>(kBareHeadSamples));
+  EXPECT_LT((o.head - SailSurface(design).head()).norm(), 0.5 * spacing);
 }
 
 }  // namespace
