@@ -525,13 +525,14 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
 // does, the one whose misfit costs least. The points' own scatter comes from
 // the second differences of their offsets, in which a smooth bend cancels and
 // noise adds 6σ² (median-based, so a stray window counts little).
-CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const Samples& smp, double spacing) {
+CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const Samples& smp, double spacing,
+                         bool from_corner) {
   const double window = 5.0 * spacing, strip = 4.0 * spacing;
   std::vector<uint32_t> idx, near;
   std::vector<double> d2, near_d2;
   std::vector<double> centre, delta;
   std::vector<Vec3> frontier;
-  for (double dw = c.from + 0.5 * window; dw + 0.5 * window <= c.to; dw += window) {
+  for (double dw = (from_corner ? 0.0 : c.from) + 0.5 * window; dw + 0.5 * window <= c.to; dw += window) {
     const Vec3 p = c.curve.at(dw), t = c.curve.tangent(dw);
     const Vec3 in = inwardAt(p, p, t, smp, near, near_d2);
     // Half the sail's width here: how far in the other edge's curve passes.
@@ -622,10 +623,27 @@ struct Meeting {
   double side_a_m = 0, side_b_m = 0;
 };
 
+// How far a corner curve turns over its first frontier window (5 boundary
+// spacings from where it was fitted), radians.
+double turnOverWindow(const CornerCurve& c, double spacing) {
+  const Vec3 t0 = c.curve.tangent(c.from), t1 = c.curve.tangent(c.from + 5.0 * spacing);
+  return std::acos(std::clamp(t0.dot(t1), -1.0, 1.0));
+}
+
 // The closest pair of points of the two edges' corner curves (quadratics in the
-// distance from the corner, extrapolated back to it). Corners of 60° and wider
-// (a tack, a clew, a square head) let their curves shorten where an edge bends;
-// narrower ones (a head) move their curves onto the samples' frontier.
+// distance from the corner, extrapolated back to it).
+//
+// Narrower corners than 60° (a head) move both curves onto the samples' frontier
+// (ontoFrontier). Wider ones (a tack, a clew, a square head) let their curves
+// shorten where an edge bends; then, if neither edge turns more than 0.08 rad
+// over a frontier window, both move onto the frontier too, with windows from the
+// corner itself over the unshortened reach. The boundary rounds off a wide corner
+// over half a metre and more: a gennaker's foot lay 2-5 cm inside its clew there,
+// and 2-3 of 90 clews came out 3.3-4.8 cm off (now at most 1.5 cm). A foot
+// leaving the tack at its entry angle turns 0.10-0.11 rad over a window, more
+// than the windows' curve follows: on the frontier it put the tack up to 3.3 cm
+// off and the upper twist 0.24° off, so such a corner keeps its shortened
+// quadratics (feet turn 0.05-0.06 rad at the clew, luffs and leeches 0.02-0.03).
 Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing, const Samples& smp) {
   const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
   auto closest = [&](const CornerCurve& ca, const CornerCurve& cb) {
@@ -653,10 +671,17 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
   CornerCurve ca = cornerCurve(a, a_start, spacing, 2, false), cb = cornerCurve(b, b_start, spacing, 2, false);
   auto [sa, sb] = closest(ca, cb);
   if (angleAt(ca, sa, cb, sb) >= kPi / 3.0) {
+    constexpr double kFollowedTurnRad = 0.08;
+    const CornerCurve fa = ontoFrontier(ca, cb, smp, spacing, true), fb = ontoFrontier(cb, ca, smp, spacing, true);
     ca = cornerCurve(a, a_start, spacing, 2, true);
     cb = cornerCurve(b, b_start, spacing, 2, true);
+    if (fa.on_frontier && fb.on_frontier && turnOverWindow(ca, spacing) < kFollowedTurnRad &&
+        turnOverWindow(cb, spacing) < kFollowedTurnRad) {
+      ca = fa;
+      cb = fb;
+    }
   } else {
-    const CornerCurve fa = ontoFrontier(ca, cb, smp, spacing), fb = ontoFrontier(cb, ca, smp, spacing);
+    const CornerCurve fa = ontoFrontier(ca, cb, smp, spacing, false), fb = ontoFrontier(cb, ca, smp, spacing, false);
     ca = fa;
     cb = fb;
   }
