@@ -524,7 +524,9 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
 // as closely as those scatter, the one known best at the corner wins; if none
 // does, the one whose misfit costs least. The points' own scatter comes from
 // the second differences of their offsets, in which a smooth bend cancels and
-// noise adds 6σ² (median-based, so a stray window counts little).
+// noise adds 6σ² (median-based, so a stray window counts little). With
+// `from_corner` the windows start at the corner itself, not where the curve's
+// own fit began (the samples reach closer to a wide corner than its boundary).
 CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const Samples& smp, double spacing,
                          bool from_corner) {
   const double window = 5.0 * spacing, strip = 4.0 * spacing;
@@ -643,7 +645,7 @@ double turnOverWindow(const CornerCurve& c, double spacing) {
 // leaving the tack at its entry angle turns 0.10-0.11 rad over a window, more
 // than the windows' curve follows: on the frontier it put the tack up to 3.3 cm
 // off and the upper twist 0.24° off, so such a corner keeps its shortened
-// quadratics (feet turn 0.05-0.06 rad at the clew, luffs and leeches 0.02-0.03).
+// quadratics (feet turn 0.05-0.06 rad at the clew, luffs and leeches 0.01-0.03).
 Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing, const Samples& smp) {
   const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
   auto closest = [&](const CornerCurve& ca, const CornerCurve& cb) {
