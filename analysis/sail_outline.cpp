@@ -233,6 +233,17 @@ struct Edge {
 // with mean (D + δ)/(n + 1). The median over the windows (a stray sample beyond
 // the edge spoils only its own window) exceeds the mean of such gaps' estimates
 // by (1 − ln 2) of a mean gap; that is taken off.
+// A window of n samples whose offsets are uniform on [−δ, D]: the least lies a
+// gap above −δ, E[gap] = (D + δ)/(n + 1), so −least = δ − gap + E[gap], solved for δ.
+double recessFromLeast(double least, double D, double n) {
+  const double q = 1.0 / (n + 1.0);
+  return (q * D - least) / (1.0 - q);
+}
+
+// The edge's strip and windows, in boundary spacings: samples within 4 inside
+// the found edge, in windows 5 long along it.
+constexpr double kFrontierStripSpacings = 4.0, kFrontierWindowSpacings = 5.0;
+
 struct Frontier {
   double recess = 0;                  // m
   size_t windows = 0;
@@ -269,11 +280,9 @@ Frontier frontierRecess(std::vector<std::pair<double, double>> along_offset, dou
   std::vector<double> deltas;
   double gap_sum = 0;
   for (const Window& w : windows) {
-    // −least = δ − gap + E[gap], E[gap] = (D + δ)/(n + 1): solved for δ.
     const double n = std::max(1.0, n_full * std::min(1.0, w.span / window));
-    const double q = 1.0 / (n + 1);
-    deltas.push_back((q * D - w.least) / (1.0 - q));
-    gap_sum += q * (D + std::max(deltas.back(), 0.0));
+    deltas.push_back(recessFromLeast(w.least, D, n));
+    gap_sum += (D + std::max(deltas.back(), 0.0)) / (n + 1.0);
     f.centre.push_back(w.centre);
     f.local.push_back(deltas.back());
   }
@@ -356,7 +365,7 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
   }
 
 
-  const double strip = 4.0 * spacing;
+  const double strip = kFrontierStripSpacings * spacing;
   double sum = 0;
   size_t count = 0;
   std::vector<char> seen(mesh.vertices.size(), 0);
@@ -394,7 +403,7 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
   // millimetre there): estimates from those are several times sharper. They
   // also hold after smoothing, which pulls a noisy scan's outermost samples in
   // less than the samples behind them (the mean came out 3-6 mm short there).
-  const Frontier frontier = count >= 30 ? frontierRecess(along_offset, strip, 5.0 * spacing) : Frontier{};
+  const Frontier frontier = count >= 30 ? frontierRecess(along_offset, strip, kFrontierWindowSpacings * spacing) : Frontier{};
   if (frontier.windows >= 6) {
     e.recess = std::clamp(frontier.recess, 0.0, strip);
     // The recess along the edge: a polynomial of the curve's degree (at most a
@@ -529,7 +538,7 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
 // own fit began (the samples reach closer to a wide corner than its boundary).
 CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const Samples& smp, double spacing,
                          bool from_corner) {
-  const double window = 5.0 * spacing, strip = 4.0 * spacing;
+  const double window = kFrontierWindowSpacings * spacing, strip = kFrontierStripSpacings * spacing;
   std::vector<uint32_t> idx, near;
   std::vector<double> d2, near_d2;
   std::vector<double> centre, delta;
@@ -557,10 +566,8 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
       ++n;
     }
     if (n < 8) continue;
-    // −least = δ − gap + E[gap], E[gap] = (D + δ)/(n + 1): solved for δ.
-    const double q = 1.0 / (static_cast<double>(n) + 1.0);
     centre.push_back(dw);
-    delta.push_back((q * D - least) / (1.0 - q));
+    delta.push_back(recessFromLeast(least, D, static_cast<double>(n)));
     frontier.push_back(p - delta.back() * in);
   }
   constexpr size_t kFewest = 6;  // a quadratic and three degrees of freedom
@@ -625,10 +632,10 @@ struct Meeting {
   double side_a_m = 0, side_b_m = 0;
 };
 
-// How far a corner curve turns over its first frontier window (5 boundary
-// spacings from where it was fitted), radians.
+// How far a corner curve turns over its first frontier window (from where it
+// was fitted), radians.
 double turnOverWindow(const CornerCurve& c, double spacing) {
-  const Vec3 t0 = c.curve.tangent(c.from), t1 = c.curve.tangent(c.from + 5.0 * spacing);
+  const Vec3 t0 = c.curve.tangent(c.from), t1 = c.curve.tangent(c.from + kFrontierWindowSpacings * spacing);
   return std::acos(std::clamp(t0.dot(t1), -1.0, 1.0));
 }
 
@@ -674,13 +681,16 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
   auto [sa, sb] = closest(ca, cb);
   if (angleAt(ca, sa, cb, sb) >= kPi / 3.0) {
     constexpr double kFollowedTurnRad = 0.08;
-    const CornerCurve fa = ontoFrontier(ca, cb, smp, spacing, true), fb = ontoFrontier(cb, ca, smp, spacing, true);
+    const CornerCurve whole_a = ca, whole_b = cb;  // unshortened: the frontier's reach
     ca = cornerCurve(a, a_start, spacing, 2, true);
     cb = cornerCurve(b, b_start, spacing, 2, true);
-    if (fa.on_frontier && fb.on_frontier && turnOverWindow(ca, spacing) < kFollowedTurnRad &&
-        turnOverWindow(cb, spacing) < kFollowedTurnRad) {
-      ca = fa;
-      cb = fb;
+    if (turnOverWindow(ca, spacing) < kFollowedTurnRad && turnOverWindow(cb, spacing) < kFollowedTurnRad) {
+      const CornerCurve fa = ontoFrontier(whole_a, whole_b, smp, spacing, true);
+      const CornerCurve fb = ontoFrontier(whole_b, whole_a, smp, spacing, true);
+      if (fa.on_frontier && fb.on_frontier) {
+        ca = fa;
+        cb = fb;
+      }
     }
   } else {
     const CornerCurve fa = ontoFrontier(ca, cb, smp, spacing, false), fb = ontoFrontier(cb, ca, smp, spacing, false);
