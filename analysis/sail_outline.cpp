@@ -241,8 +241,10 @@ double recessFromLeast(double least, double D, double n) {
 }
 
 // The edge's strip and windows, in boundary spacings: samples within 4 inside
-// the found edge, in windows 5 long along it.
+// the found edge, in windows 5 long along it, or 1/8 of a shorter edge's reach
+// (a square top's top edge), if no less than a spacing.
 constexpr double kFrontierStripSpacings = 4.0, kFrontierWindowSpacings = 5.0;
+constexpr double kFrontierFewestWindows = 8.0;
 
 struct Frontier {
   double recess = 0;                  // m
@@ -307,9 +309,10 @@ struct Samples {
 
 // The direction into the surface across an edge through `at` with unit tangent
 // t: the mean normal of the 24 vertices nearest `near` × t, turned towards their
-// centroid. (Unit to within how far t leaves the surface.)
+// centroid. (Unit to within how far t leaves the surface.) With `on_surface`,
+// also `at` moved along that normal onto the vertices' plane.
 Vec3 inwardAt(const Vec3& near, const Vec3& at, const Vec3& t, const Samples& smp, std::vector<uint32_t>& idx,
-              std::vector<double>& d2) {
+              std::vector<double>& d2, Vec3* on_surface = nullptr) {
   smp.tree.nearest(near, 24, idx, d2);
   Vec3 n = Vec3::Zero(), centre = Vec3::Zero();
   for (uint32_t v : idx) {
@@ -317,8 +320,10 @@ Vec3 inwardAt(const Vec3& near, const Vec3& at, const Vec3& t, const Samples& sm
     centre += smp.mesh.vertices[v];
   }
   centre /= static_cast<double>(idx.size());
-  Vec3 in = n.normalized().cross(t);
+  n.normalize();
+  Vec3 in = n.cross(t);
   if (in.dot(centre - at) < 0) in = -in;
+  if (on_surface) *on_surface = at - (at - centre).dot(n) * n;
   return in;
 }
 
@@ -536,16 +541,35 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
 // noise adds 6σ² (median-based, so a stray window counts little). With
 // `from_corner` the windows start at the corner itself, not where the curve's
 // own fit began (the samples reach closer to a wide corner than its boundary).
+//
+// An edge too short for 8 windows of 5 spacings takes 8 shorter ones, down to
+// a spacing each. A square top's top edge, 1.2-1.5 m long, had 2 windows, too
+// few, and kept its corner curve: a straight line through a dozen boundary
+// vertices of a section with its own camber, which passed 8-10 cm off the
+// surface at the head and met the leech 5 cm below the peak. On such an edge
+// each frontier point is also taken on the surface under the curve (the mean
+// plane of the 24 vertices nearest it), not on the curve: the offsets o are
+// measured across the surface, so a curve that leaves it in depth would carry
+// that into every point. On a longer edge the curve follows the surface to a
+// millimetre, and those planes would only add their own scatter (5 mm along a
+// mainsail's foot, enough to fail the residual test). In sparse scans (12,000
+// points and under) most edges are that short: square-top heads and peaks, and
+// the tacks of mains and jibs at 5,000 points, came out closer, the rest about
+// as before.
 CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const Samples& smp, double spacing,
                          bool from_corner) {
-  const double window = kFrontierWindowSpacings * spacing, strip = kFrontierStripSpacings * spacing;
+  const double start = from_corner ? 0.0 : c.from;
+  const double window = std::clamp((c.to - start) / kFrontierFewestWindows, spacing, kFrontierWindowSpacings * spacing);
+  const double strip = kFrontierStripSpacings * spacing;
+  const bool short_edge = window < kFrontierWindowSpacings * spacing;
   std::vector<uint32_t> idx, near;
   std::vector<double> d2, near_d2;
   std::vector<double> centre, delta;
   std::vector<Vec3> frontier;
-  for (double dw = (from_corner ? 0.0 : c.from) + 0.5 * window; dw + 0.5 * window <= c.to; dw += window) {
+  for (double dw = start + 0.5 * window; dw + 0.5 * window <= c.to + 1e-9 * window; dw += window) {
     const Vec3 p = c.curve.at(dw), t = c.curve.tangent(dw);
-    const Vec3 in = inwardAt(p, p, t, smp, near, near_d2);
+    Vec3 on_surface;
+    const Vec3 in = inwardAt(p, p, t, smp, near, near_d2, &on_surface);
     // Half the sail's width here: how far in the other edge's curve passes.
     double across = std::numeric_limits<double>::infinity();
     for (int i = 0; i <= 60; ++i) {
@@ -568,7 +592,7 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
     if (n < 8) continue;
     centre.push_back(dw);
     delta.push_back(recessFromLeast(least, D, static_cast<double>(n)));
-    frontier.push_back(p - delta.back() * in);
+    frontier.push_back((short_edge ? on_surface : p) - delta.back() * in);
   }
   constexpr size_t kFewest = 6;  // a quadratic and three degrees of freedom
   if (centre.size() < kFewest) return c;

@@ -116,25 +116,48 @@ TEST(Pipeline, SquareTopPeakStaysWithinTheTargetWhereItsShortTopEdgeIsThinlySamp
   }
 }
 
-TEST(Pipeline, ASquareHeadUnderAMetreWideKeepsItsFourCorners) {
-  // A 0.9 m head on a 12 m luff, 3 % of the 29 m outline. A 4th corner once had to
-  // stand 4 corner windows (1 % of the outline each) from the others, and this
-  // one, 3.0 windows from the head, made the sail a triangle with its head midway
-  // across the top edge. Kinks beside a triangle's head turn under 40° over the
-  // window (under 20° over twice it); this peak turns 70°.
+// A square top of the given size, its head and peak within the corner target
+// on each (noise, seed) run of 40,000 points.
+SailDesign squareTop(double luff_m, double leech_m, double foot_m, double head_width_m) {
   SailDesign design = exampleDesign(SailType::SquareTopMain);
-  design.luff_m = 12.0;
-  design.leech_m = 12.1;
-  design.foot_m = 4.0;
-  design.head_width_m = 0.9;
+  design.luff_m = luff_m;
+  design.leech_m = leech_m;
+  design.foot_m = foot_m;
+  design.head_width_m = head_width_m;
+  return design;
+}
+void expectSquareHeadCorners(const SailDesign& design, std::initializer_list<std::pair<double, int>> runs) {
   const SailSurface truth(design);
-  for (const auto& [noise, seed] : {std::pair{0.0, 1}, {kSigma, 2}}) {
+  for (const auto& [noise, seed] : runs) {
     SCOPED_TRACE("noise " + std::to_string(noise) + " seed " + std::to_string(seed));
     const SailAnalysis a = analyzeSail(sampleSail(design, scan(40000, static_cast<uint64_t>(seed), noise)));
     ASSERT_TRUE(a.outline.has_peak);
     EXPECT_LT((a.outline.peak - truth.peak()).norm(), kClean.corner_m);
     EXPECT_LT((a.outline.head - truth.head()).norm(), kClean.corner_m);
   }
+}
+
+TEST(Pipeline, ASquareHeadUnderAMetreWideKeepsItsFourCorners) {
+  // A 0.9 m head on a 12 m luff, 3 % of the 29 m outline. A 4th corner once had to
+  // stand 4 corner windows (1 % of the outline each) from the others, and this
+  // one, 3.0 windows from the head, made the sail a triangle with its head midway
+  // across the top edge. Kinks beside a triangle's head turn under 40° over the
+  // window (under 20° over twice it); this peak turns 70°.
+  expectSquareHeadCorners(squareTop(12.0, 12.1, 4.0, 0.9), {{0.0, 1}, {kSigma, 2}});
+}
+
+// A square top's top edge is a short section with its own camber: 1.35 m of
+// chord 13 % deep here, a curve the boundary samples of a few windows cannot
+// place. Fitted as a straight line through its dozen boundary vertices, the top
+// passed 8-10 cm off the surface at the head, and its crossing with the leech
+// came out 2.8-3.8 cm off at the peak on these seeds (5 cm on an independent
+// sail's). Frontier windows an eighth of the edge long, with their points taken
+// on the surface, follow the camber and meet the luff and the leech where the
+// sail's corners are.
+TEST(Pipeline, ADeepShortTopEdgeMeetsLuffAndLeechAtTheSquareHeadsCorners) {
+  SailDesign design = squareTop(13.0, 13.1, 4.6, 1.35);
+  design.stations.back().camber_pct = 13;
+  expectSquareHeadCorners(design, {{0.0, 1}, {0.0, 2}, {0.0, 3}, {kSigma, 4}, {kSigma, 5}, {kSigma, 6}});
 }
 
 // A clean scan loses no sample. The radius filter drops a gennaker's last samples
@@ -535,15 +558,24 @@ void expectSparseSceneReadsAsTheSailAlone(size_t points, uint64_t seeds) {
       EXPECT_LT((a.outline.clew - truth.clew()).norm(), corner_m);
       EXPECT_LT((a.outline.head - truth.head()).norm(), corner_m);
       EXPECT_LT((a.outline.peak - truth.peak()).norm(), corner_m);
-      // Its sections read as the sail's alone do, to half the noise targets: a fat
-      // cylinder through the mast and the luff beside it once took the luff's points
-      // and 0.25 % of the camber.
+      // Its sections lie no further from the truth than the sail's alone do, by more
+      // than half the noise targets: a fat cylinder through the mast and the luff
+      // beside it once took the luff's points and 0.25 % of the camber. (One sample
+      // more or less at a corner 9 cm from the next moves it by centimetres, so the
+      // two analyses differ either way; a scene that reads closer to the truth than
+      // the sail alone has lost nothing.)
       const SailAnalysis alone = analyzeSail(sampleSail(design, scan(points, seed, noise)));
       ASSERT_EQ(a.sections.sections.size(), alone.sections.sections.size());
       for (size_t i = 0; i < a.sections.sections.size(); ++i) {
         const Section &in_scene = a.sections.sections[i], &by_itself = alone.sections.sections[i];
-        EXPECT_NEAR(in_scene.value.camber_pct, by_itself.value.camber_pct, 0.15) << "section " << i;
-        EXPECT_NEAR(in_scene.value.twist_deg, by_itself.value.twist_deg, 0.15) << "section " << i;
+        ASSERT_DOUBLE_EQ(in_scene.fraction, by_itself.fraction);
+        const KnownSection k = truth.section(in_scene.fraction);
+        EXPECT_LE(std::abs(in_scene.value.camber_pct - k.camber_pct),
+                  std::abs(by_itself.value.camber_pct - k.camber_pct) + 0.15)
+            << "section " << i;
+        EXPECT_LE(std::abs(in_scene.value.twist_deg - k.twist_deg),
+                  std::abs(by_itself.value.twist_deg - k.twist_deg) + 0.15)
+            << "section " << i;
       }
     }
 }
