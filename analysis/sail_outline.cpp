@@ -556,10 +556,15 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
 // points and under) most edges are that short: square-top heads and peaks, and
 // the tacks of mains and jibs at 5,000 points, came out closer, the rest about
 // as before.
+double frontierWindow(const CornerCurve& c, bool from_corner, double spacing) {
+  const double start = from_corner ? 0.0 : c.from;
+  return std::clamp((c.to - start) / kFrontierFewestWindows, spacing, kFrontierWindowSpacings * spacing);
+}
+
 CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const Samples& smp, double spacing,
                          bool from_corner) {
   const double start = from_corner ? 0.0 : c.from;
-  const double window = std::clamp((c.to - start) / kFrontierFewestWindows, spacing, kFrontierWindowSpacings * spacing);
+  const double window = frontierWindow(c, from_corner, spacing);
   const double strip = kFrontierStripSpacings * spacing;
   const bool short_edge = window < kFrontierWindowSpacings * spacing;
   std::vector<uint32_t> idx, near;
@@ -658,8 +663,8 @@ struct Meeting {
 
 // How far a corner curve turns over its first frontier window (from where it
 // was fitted), radians.
-double turnOverWindow(const CornerCurve& c, double spacing) {
-  const Vec3 t0 = c.curve.tangent(c.from), t1 = c.curve.tangent(c.from + kFrontierWindowSpacings * spacing);
+double turnOverWindow(const CornerCurve& c, double window) {
+  const Vec3 t0 = c.curve.tangent(c.from), t1 = c.curve.tangent(c.from + window);
   return std::acos(std::clamp(t0.dot(t1), -1.0, 1.0));
 }
 
@@ -677,6 +682,10 @@ double turnOverWindow(const CornerCurve& c, double spacing) {
 // than the windows' curve follows: on the frontier it put the tack up to 3.3 cm
 // off and the upper twist 0.24° off, so such a corner keeps its shortened
 // quadratics (feet turn 0.05-0.06 rad at the clew, luffs and leeches 0.01-0.03).
+// The window is the one ontoFrontier would use on that edge: a square top's
+// 2.2 m top edge, cambered, turned 0.09 rad over 5 spacings but half that over
+// its own shorter windows, and kept quadratics that put head and peak 4-6 cm
+// low.
 Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing, const Samples& smp) {
   const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
   auto closest = [&](const CornerCurve& ca, const CornerCurve& cb) {
@@ -708,7 +717,8 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
     const CornerCurve whole_a = ca, whole_b = cb;  // unshortened: the frontier's reach
     ca = cornerCurve(a, a_start, spacing, 2, true);
     cb = cornerCurve(b, b_start, spacing, 2, true);
-    if (turnOverWindow(ca, spacing) < kFollowedTurnRad && turnOverWindow(cb, spacing) < kFollowedTurnRad) {
+    if (turnOverWindow(ca, frontierWindow(whole_a, true, spacing)) < kFollowedTurnRad &&
+        turnOverWindow(cb, frontierWindow(whole_b, true, spacing)) < kFollowedTurnRad) {
       const CornerCurve fa = ontoFrontier(whole_a, whole_b, smp, spacing, true);
       const CornerCurve fb = ontoFrontier(whole_b, whole_a, smp, spacing, true);
       if (fa.on_frontier && fb.on_frontier) {
