@@ -255,8 +255,9 @@ struct Frontier {
 };
 
 Frontier frontierRecess(std::vector<std::pair<double, double>> along_offset, double D, double window) {
-  std::sort(along_offset.begin(), along_offset.end());
   Frontier f;
+  if (!(window > 0)) return f;  // no spacing to step by
+  std::sort(along_offset.begin(), along_offset.end());
   struct Window {
     double centre, span, least;
     size_t n;
@@ -565,6 +566,7 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
                          bool from_corner) {
   const double start = from_corner ? 0.0 : c.from;
   const double window = frontierWindow(c, from_corner, spacing);
+  if (!(window > 0)) return c;  // no spacing to step by
   const double strip = kFrontierStripSpacings * spacing;
   const bool short_edge = window < kFrontierWindowSpacings * spacing;
   std::vector<uint32_t> idx, near;
