@@ -241,8 +241,8 @@ double recessFromLeast(double least, double D, double n) {
 }
 
 // The edge's strip and windows, in boundary spacings: samples within 4 inside
-// the found edge, in windows 5 long along it, or 1/8 of a shorter edge's reach
-// (a square top's top edge), if no less than a spacing.
+// the found edge, in windows 5 long along it (fitEdge's always; ontoFrontier's
+// 1/8 of a shorter edge's reach, but no less than a spacing: frontierWindow).
 constexpr double kFrontierStripSpacings = 4.0, kFrontierWindowSpacings = 5.0;
 constexpr double kFrontierFewestWindows = 8.0;
 
@@ -308,12 +308,16 @@ struct Samples {
   const PointGrid& tree;
 };
 
-// The direction into the surface across an edge through `at` with unit tangent
-// t: the mean normal of the 24 vertices nearest `near` × t, turned towards their
-// centroid. (Unit to within how far t leaves the surface.) With `on_surface`,
-// also `at` moved along that normal onto the vertices' plane.
-Vec3 inwardAt(const Vec3& near, const Vec3& at, const Vec3& t, const Samples& smp, std::vector<uint32_t>& idx,
-              std::vector<double>& d2, Vec3* on_surface = nullptr) {
+// Across an edge through `at` with unit tangent t: the direction into the
+// surface, the mean normal of the 24 vertices nearest `near` × t, turned towards
+// their centroid (unit to within how far t leaves the surface); and `at` moved
+// along that normal onto the vertices' plane.
+struct Across {
+  Vec3 in = Vec3::Zero();
+  Vec3 on_surface = Vec3::Zero();
+};
+Across acrossAt(const Vec3& near, const Vec3& at, const Vec3& t, const Samples& smp, std::vector<uint32_t>& idx,
+                std::vector<double>& d2) {
   smp.tree.nearest(near, 24, idx, d2);
   Vec3 n = Vec3::Zero(), centre = Vec3::Zero();
   for (uint32_t v : idx) {
@@ -322,10 +326,11 @@ Vec3 inwardAt(const Vec3& near, const Vec3& at, const Vec3& t, const Samples& sm
   }
   centre /= static_cast<double>(idx.size());
   n.normalize();
-  Vec3 in = n.cross(t);
-  if (in.dot(centre - at) < 0) in = -in;
-  if (on_surface) *on_surface = at - (at - centre).dot(n) * n;
-  return in;
+  Across a;
+  a.in = n.cross(t);
+  if (a.in.dot(centre - at) < 0) a.in = -a.in;
+  a.on_surface = at - (at - centre).dot(n) * n;
+  return a;
 }
 
 // A sampled surface's boundary lies inside the true edge: the outermost samples
@@ -367,7 +372,7 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
   std::vector<Vec3> inward(e.points.size());
   for (size_t i = 0; i < e.points.size(); ++i) {
     const double si = std::clamp(e.s[i], e.exclude, e.length - e.exclude);
-    inward[i] = inwardAt(e.points[i], e.curve.at(si), e.curve.tangent(si), smp, idx, d2);
+    inward[i] = acrossAt(e.points[i], e.curve.at(si), e.curve.tangent(si), smp, idx, d2).in;
   }
 
 
@@ -521,6 +526,14 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
   return c;
 }
 
+// The length of ontoFrontier's windows on corner curve c: 5 spacings, or 1/8 of
+// the curve's reach (from the corner, or from where its fit began) where that is
+// shorter, but no less than a spacing.
+double frontierWindow(const CornerCurve& c, bool from_corner, double spacing) {
+  const double start = from_corner ? 0.0 : c.from;
+  return std::clamp((c.to - start) / kFrontierFewestWindows, spacing, kFrontierWindowSpacings * spacing);
+}
+
 // A corner curve fitted through the boundary vertices carries their scatter (a
 // gap each: about a centimetre on a 40,000-point gennaker), and fitted over 60
 // boundary spacings it cannot follow how an edge bends on the last few metres
@@ -557,11 +570,6 @@ CornerCurve cornerCurve(const Edge& e, bool at_start, double spacing, int degree
 // points and under) most edges are that short: square-top heads and peaks, and
 // the tacks of mains and jibs at 5,000 points, came out closer, the rest about
 // as before.
-double frontierWindow(const CornerCurve& c, bool from_corner, double spacing) {
-  const double start = from_corner ? 0.0 : c.from;
-  return std::clamp((c.to - start) / kFrontierFewestWindows, spacing, kFrontierWindowSpacings * spacing);
-}
-
 CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const Samples& smp, double spacing,
                          bool from_corner) {
   const double start = from_corner ? 0.0 : c.from;
@@ -575,8 +583,8 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
   std::vector<Vec3> frontier;
   for (double dw = start + 0.5 * window; dw + 0.5 * window <= c.to + 1e-9 * window; dw += window) {
     const Vec3 p = c.curve.at(dw), t = c.curve.tangent(dw);
-    Vec3 on_surface;
-    const Vec3 in = inwardAt(p, p, t, smp, near, near_d2, &on_surface);
+    const Across across_edge = acrossAt(p, p, t, smp, near, near_d2);
+    const Vec3& in = across_edge.in;
     // Half the sail's width here: how far in the other edge's curve passes.
     double across = std::numeric_limits<double>::infinity();
     for (int i = 0; i <= 60; ++i) {
@@ -599,7 +607,7 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
     if (n < 8) continue;
     centre.push_back(dw);
     delta.push_back(recessFromLeast(least, D, static_cast<double>(n)));
-    frontier.push_back((short_edge ? on_surface : p) - delta.back() * in);
+    frontier.push_back((short_edge ? across_edge.on_surface : p) - delta.back() * in);
   }
   constexpr size_t kFewest = 6;  // a quadratic and three degrees of freedom
   if (centre.size() < kFewest) return c;
@@ -680,14 +688,17 @@ double turnOverWindow(const CornerCurve& c, double window) {
 // corner itself over the unshortened reach. The boundary rounds off a wide corner
 // over half a metre and more: a gennaker's foot lay 2-5 cm inside its clew there,
 // and 2-3 of 90 clews came out 3.3-4.8 cm off (now at most 1.5 cm). A foot
-// leaving the tack at its entry angle turns 0.10-0.11 rad over a window, more
+// leaving the tack at its entry angle turns 0.10-0.11 rad over 5 spacings, more
 // than the windows' curve follows: on the frontier it put the tack up to 3.3 cm
 // off and the upper twist 0.24° off, so such a corner keeps its shortened
 // quadratics (feet turn 0.05-0.06 rad at the clew, luffs and leeches 0.01-0.03).
-// The window is the one ontoFrontier would use on that edge: a square top's
-// 2.2 m top edge, cambered, turned 0.09 rad over 5 spacings but half that over
-// its own shorter windows, and kept quadratics that put head and peak 4-6 cm
-// low.
+// The window is the one ontoFrontier would use on that edge (shorter on a short
+// edge): a square top's 2.2 m top edge, cambered, turned 0.085-0.093 rad over 5
+// spacings but less over its own windows, and had kept quadratics that put head
+// and peak 4-6 cm low. In sparse scans most edges are short, and a foot may turn
+// up to 0.08 rad over its shorter window where over 5 spacings it would be
+// refused: tacks and clews at 5,000-12,000 points came out closer on the whole
+// (the worst run worse in 2 of 16 sets of 20).
 Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, double spacing, const Samples& smp) {
   const double range = 3.0 * spacing + std::max({60.0 * spacing, 0.05 * a.length, 0.05 * b.length});
   auto closest = [&](const CornerCurve& ca, const CornerCurve& cb) {

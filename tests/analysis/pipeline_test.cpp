@@ -116,8 +116,7 @@ TEST(Pipeline, SquareTopPeakStaysWithinTheTargetWhereItsShortTopEdgeIsThinlySamp
   }
 }
 
-// A square top of the given size, its head and peak within the corner target
-// on each (noise, seed) run of 40,000 points.
+// The example square top at these sizes.
 SailDesign squareTop(double luff_m, double leech_m, double foot_m, double head_width_m) {
   SailDesign design = exampleDesign(SailType::SquareTopMain);
   design.luff_m = luff_m;
@@ -126,14 +125,18 @@ SailDesign squareTop(double luff_m, double leech_m, double foot_m, double head_w
   design.head_width_m = head_width_m;
   return design;
 }
-void expectSquareHeadCorners(const SailDesign& design, std::initializer_list<std::pair<double, int>> runs) {
+
+// Its head and peak within corner_m of the truth on each (noise, seed) run of
+// 40,000 points.
+void expectSquareHeadCorners(const SailDesign& design, std::initializer_list<std::pair<double, int>> runs,
+                             double corner_m = kClean.corner_m) {
   const SailSurface truth(design);
   for (const auto& [noise, seed] : runs) {
     SCOPED_TRACE("noise " + std::to_string(noise) + " seed " + std::to_string(seed));
     const SailAnalysis a = analyzeSail(sampleSail(design, scan(40000, static_cast<uint64_t>(seed), noise)));
     ASSERT_TRUE(a.outline.has_peak);
-    EXPECT_LT((a.outline.peak - truth.peak()).norm(), kClean.corner_m);
-    EXPECT_LT((a.outline.head - truth.head()).norm(), kClean.corner_m);
+    EXPECT_LT((a.outline.peak - truth.peak()).norm(), corner_m);
+    EXPECT_LT((a.outline.head - truth.head()).norm(), corner_m);
   }
 }
 
@@ -151,9 +154,9 @@ TEST(Pipeline, ASquareHeadUnderAMetreWideKeepsItsFourCorners) {
 // place. Fitted as a straight line through its dozen boundary vertices, the top
 // passed 8-10 cm off the surface at the head, and its crossing with the leech
 // came out 2.8-3.8 cm off at the peak on these seeds (5 cm on an independent
-// sail's). Frontier windows an eighth of the edge long, with their points taken
-// on the surface, follow the camber and meet the luff and the leech where the
-// sail's corners are.
+// sail's). Frontier windows an eighth of the edge's reach long (the edge less 3
+// spacings), with their points taken on the surface, follow the camber and meet
+// the luff and the leech where the sail's corners are: within 0.3-2.4 cm here.
 TEST(Pipeline, ADeepShortTopEdgeMeetsLuffAndLeechAtTheSquareHeadsCorners) {
   SailDesign design = squareTop(13.0, 13.1, 4.6, 1.35);
   design.stations.back().camber_pct = 13;
@@ -165,21 +168,14 @@ TEST(Pipeline, ADeepShortTopEdgeMeetsLuffAndLeechAtTheSquareHeadsCorners) {
 // kept the quadratics through the boundary, which the rounded-off ends pull in,
 // and these runs' heads and peaks came out up to 3.9 cm off (3 of 6 over half a
 // sample spacing). Judged over the shorter windows the frontier takes on an edge
-// this short, it turns less than that, and the corners lie within half a spacing.
+// this short, it turns less than that, and the corners lie within half a spacing
+// (1.6 cm; they came out within 0.2-1.3 cm).
 TEST(Pipeline, AWideTopEdgeIsJudgedOverTheFrontierWindowsItWouldTake) {
   SailDesign design = squareTop(11.35, 11.4, 5.0, 2.16);
   design.stations.back().camber_pct = 8;
   design.stations.back().draft_pct = 48;
-  const SailSurface truth(design);
-  constexpr size_t kPoints = 40000;
-  const double half_spacing = 0.5 * std::sqrt(meshArea(generateSailMesh(design)) / static_cast<double>(kPoints));
-  for (const auto& [noise, seed] : {std::pair{0.0, 1}, {0.0, 3}, {0.0, 6}, {kSigma, 1}, {kSigma, 3}, {kSigma, 6}}) {
-    SCOPED_TRACE("noise " + std::to_string(noise) + " seed " + std::to_string(seed));
-    const SailAnalysis a = analyzeSail(sampleSail(design, scan(kPoints, static_cast<uint64_t>(seed), noise)));
-    ASSERT_TRUE(a.outline.has_peak);
-    EXPECT_LT((a.outline.head - truth.head()).norm(), half_spacing);
-    EXPECT_LT((a.outline.peak - truth.peak()).norm(), half_spacing);
-  }
+  const double half_spacing = 0.5 * std::sqrt(meshArea(generateSailMesh(design)) / 40000.0);
+  expectSquareHeadCorners(design, {{0.0, 1}, {0.0, 3}, {0.0, 6}, {kSigma, 1}, {kSigma, 3}, {kSigma, 6}}, half_spacing);
 }
 
 // A clean scan loses no sample. The radius filter drops a gennaker's last samples
@@ -545,7 +541,8 @@ TEST(Pipeline, SceneWithMastBoomAndDeckIsSegmentedToTheSail) {
 
 // The square top in its scene, `points` samples on the sail, seeds 1 to `seeds`, clean
 // and with σ noise: both spars found, the sail's cluster clean, corners within two sample
-// spacings and sections within half the noise targets of the sail analysed alone.
+// spacings, and sections no further from the truth than the sail's analysed alone by
+// more than half the noise targets (nor from the sail alone's by more than the targets).
 void expectSparseSceneReadsAsTheSailAlone(size_t points, uint64_t seeds) {
   const SailDesign design = exampleDesign(SailType::SquareTopMain);
   const SailSurface truth(design);
@@ -598,6 +595,8 @@ void expectSparseSceneReadsAsTheSailAlone(size_t points, uint64_t seeds) {
         EXPECT_LE(std::abs(in_scene.value.twist_deg - k.twist_deg),
                   std::abs(by_itself.value.twist_deg - k.twist_deg) + 0.15)
             << "section " << i;
+        EXPECT_NEAR(in_scene.value.camber_pct, by_itself.value.camber_pct, 0.3) << "section " << i;
+        EXPECT_NEAR(in_scene.value.twist_deg, by_itself.value.twist_deg, 0.3) << "section " << i;
       }
     }
 }
