@@ -116,6 +116,11 @@ TEST(Pipeline, SquareTopPeakStaysWithinTheTargetWhereItsShortTopEdgeIsThinlySamp
   }
 }
 
+// The mean distance between `points` samples spread over the design's surface, m.
+double sampleSpacing(const SailDesign& design, size_t points) {
+  return std::sqrt(meshArea(generateSailMesh(design)) / static_cast<double>(points));
+}
+
 // The example square top at these sizes.
 SailDesign squareTop(double luff_m, double leech_m, double foot_m, double head_width_m) {
   SailDesign design = exampleDesign(SailType::SquareTopMain);
@@ -127,13 +132,15 @@ SailDesign squareTop(double luff_m, double leech_m, double foot_m, double head_w
 }
 
 // Its head and peak within corner_m of the truth on each (noise, seed) run of
-// 40,000 points.
+// kSquareHeadPoints.
+constexpr size_t kSquareHeadPoints = 40000;
 void expectSquareHeadCorners(const SailDesign& design, std::initializer_list<std::pair<double, int>> runs,
                              double corner_m = kClean.corner_m) {
   const SailSurface truth(design);
   for (const auto& [noise, seed] : runs) {
     SCOPED_TRACE("noise " + std::to_string(noise) + " seed " + std::to_string(seed));
-    const SailAnalysis a = analyzeSail(sampleSail(design, scan(40000, static_cast<uint64_t>(seed), noise)));
+    const SailAnalysis a =
+        analyzeSail(sampleSail(design, scan(kSquareHeadPoints, static_cast<uint64_t>(seed), noise)));
     ASSERT_TRUE(a.outline.has_peak);
     EXPECT_LT((a.outline.peak - truth.peak()).norm(), corner_m);
     EXPECT_LT((a.outline.head - truth.head()).norm(), corner_m);
@@ -174,7 +181,7 @@ TEST(Pipeline, AWideTopEdgeIsJudgedOverTheFrontierWindowsItWouldTake) {
   SailDesign design = squareTop(11.35, 11.4, 5.0, 2.16);
   design.stations.back().camber_pct = 8;
   design.stations.back().draft_pct = 48;
-  const double half_spacing = 0.5 * std::sqrt(meshArea(generateSailMesh(design)) / 40000.0);
+  const double half_spacing = 0.5 * sampleSpacing(design, kSquareHeadPoints);
   expectSquareHeadCorners(design, {{0.0, 1}, {0.0, 3}, {0.0, 6}, {kSigma, 1}, {kSigma, 3}, {kSigma, 6}}, half_spacing);
 }
 
@@ -546,8 +553,8 @@ TEST(Pipeline, SceneWithMastBoomAndDeckIsSegmentedToTheSail) {
 void expectSparseSceneReadsAsTheSailAlone(size_t points, uint64_t seeds) {
   const SailDesign design = exampleDesign(SailType::SquareTopMain);
   const SailSurface truth(design);
-  const double area = meshArea(generateSailMesh(design));
   const double n = static_cast<double>(points);
+  const double corner_m = 2 * sampleSpacing(design, points);
   for (double noise : {0.0, kSigma})
     for (uint64_t seed = 1; seed <= seeds; ++seed) {
       SCOPED_TRACE(std::to_string(points) + " points, seed " + std::to_string(seed) + ", noise " +
@@ -571,7 +578,6 @@ void expectSparseSceneReadsAsTheSailAlone(size_t points, uint64_t seeds) {
       EXPECT_GE(static_cast<double>(seg.points_out), 0.98 * n);
       // Corners within two sample spacings, as the sail alone (the sparse tips are
       // rounded off over a few of them).
-      const double corner_m = 2 * std::sqrt(area / n);
       ASSERT_TRUE(a.outline.has_peak);
       EXPECT_LT((a.outline.tack - truth.tack()).norm(), corner_m);
       EXPECT_LT((a.outline.clew - truth.clew()).norm(), corner_m);
