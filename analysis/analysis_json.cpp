@@ -98,6 +98,8 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
   const Smoothing& sm = a.smoothing_stats;
   j["diagnostics"] = {{"points_in", a.points_in},
                       {"sail_points", a.sail_points},
+                      {"working_points", a.working_points},
+                      {"working_voxel_m", a.working_voxel_m},
                       {"mesh_vertices", a.mesh.vertices.size()},
                       {"mesh_triangles", a.mesh.triangles.size()},
                       {"stages", stages},

@@ -6,6 +6,7 @@
 #include <mutex>
 #include <nanoflann.hpp>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "analysis/errors.hpp"
@@ -781,5 +782,43 @@ double selectNearest(const std::vector<double>& d2, double limit2, size_t k, std
   return t;
 }
 
+
+VoxelMeans voxelMeans(const Cloud& in, double voxel_m) {
+  if (!(voxel_m > 0) || !std::isfinite(voxel_m))
+    throw InvalidInput("[voxelMeans] voxel must be > 0 and finite (got " + std::to_string(voxel_m) + " m)");
+  VoxelMeans out;
+  out.cloud.viewpoint = in.viewpoint;
+  out.voxel_of.resize(in.size());
+  KeyIds index(in.size() / 4);
+  std::vector<Vec3> sum;
+  for (size_t i = 0; i < in.size(); ++i) {
+    const uint32_t v = index.idOf(voxelKey(in.points[i], voxel_m));
+    if (v == sum.size()) {
+      sum.push_back(Vec3::Zero());
+      out.count.push_back(0);
+    }
+    sum[v] += in.points[i];
+    ++out.count[v];
+    out.voxel_of[i] = v;
+  }
+  const size_t n = sum.size();
+  out.cloud.points.resize(n);
+  for (size_t v = 0; v < n; ++v) out.cloud.points[v] = sum[v] / static_cast<double>(out.count[v]);
+  auto average = [&](const auto& values, auto& means) {
+    if (values.empty()) return;
+    if (values.size() != in.size())
+      throw InvalidInput("[voxelMeans] an attribute has " + std::to_string(values.size()) + " values for " +
+                         std::to_string(in.size()) + " points");
+    std::vector<double> total(n, 0.0);
+    for (size_t i = 0; i < in.size(); ++i) total[out.voxel_of[i]] += static_cast<double>(values[i]);
+    means.resize(n);
+    for (size_t v = 0; v < n; ++v)
+      means[v] = static_cast<typename std::decay_t<decltype(means)>::value_type>(total[v] / out.count[v]);
+  };
+  average(in.intensity, out.cloud.intensity);
+  average(in.alpha_rad, out.cloud.alpha_rad);
+  average(in.beta_rad, out.cloud.beta_rad);
+  return out;
+}
 
 }  // namespace sailshape

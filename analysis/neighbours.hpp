@@ -124,6 +124,17 @@ Eigen::Vector3i voxelOf(const Vec3& p, double size);
 int64_t voxelKey(const Eigen::Vector3i& cell);
 inline int64_t voxelKey(const Vec3& p, double size) { return voxelKey(voxelOf(p, size)); }
 
+// One point per occupied voxel of a grid `voxel_m` wide (voxelOf's cells): the mean
+// of its points and of each attribute they carry, in the order the voxels are first
+// met; with each input point's voxel and each voxel's count. Throws InvalidInput for
+// a voxel that is not positive and finite.
+struct VoxelMeans {
+  Cloud cloud;                     // keeps the input's viewpoint
+  std::vector<uint32_t> voxel_of;  // per input point
+  std::vector<uint32_t> count;     // per voxel
+};
+VoxelMeans voxelMeans(const Cloud& cloud, double voxel_m);
+
 // Of the slots j with d2[j] <= limit2, the k nearest by (distance², slot) into
 // `out`; returns the k-th distance², or -1 when fewer than k lie within limit2.
 // The squared distances are counted in bins of limit2 / kBins (a sample spread

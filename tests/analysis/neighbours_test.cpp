@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <string>
@@ -507,6 +508,58 @@ TEST(KeyIds, NumbersKeysInTheOrderFirstSeenAndKeepsThemWhileGrowing) {
   const uint32_t a = voxels.idOf(voxelKey(Vec3(0.01, 0.02, 0.03), 0.1));
   EXPECT_EQ(voxels.idOf(voxelKey(Vec3(0.09, 0.08, 0.07), 0.1)), a);
   EXPECT_EQ(voxels.idOf(voxelKey(Vec3(0.11, 0.02, 0.03), 0.1)), a + 1);
+}
+
+TEST(VoxelMeans, AveragesEachVoxelsPointsAndAttributesInTheOrderFirstMet) {
+  // Cubes 0.1 m wide: three points in [0, 0.1)³, one in the cube above, one more
+  // back in the first, and one in the cube to -x (floor, not truncation, at 0).
+  Cloud c;
+  c.points = {Vec3(0.01, 0.02, 0.03), Vec3(0.05, 0.06, 0.07), Vec3(0.02, 0.04, 0.05), Vec3(0.05, 0.05, 0.15),
+              Vec3(0.09, 0.08, 0.01), Vec3(-0.01, 0.05, 0.05)};
+  c.intensity = {10, 20, 30, 40, 60, 70};
+  c.alpha_rad = {0.1, 0.2, 0.3, 0.4, 0.6, 0.7};
+  c.beta_rad = {-1, -2, -3, -4, -6, -7};
+  c.viewpoint = Vec3(5, 0, 1);
+  const VoxelMeans m = voxelMeans(c, 0.1);
+  ASSERT_EQ(m.cloud.size(), 3u);
+  EXPECT_EQ(m.count, (std::vector<uint32_t>{4, 1, 1}));
+  EXPECT_EQ(m.voxel_of, (std::vector<uint32_t>{0, 0, 0, 1, 0, 2}));
+  EXPECT_LT((m.cloud.points[0] - Vec3(0.0425, 0.05, 0.04)).norm(), 1e-15);
+  EXPECT_EQ(m.cloud.points[1], c.points[3]);
+  EXPECT_EQ(m.cloud.points[2], c.points[5]);
+  EXPECT_FLOAT_EQ(m.cloud.intensity[0], 30.0f);
+  EXPECT_NEAR(m.cloud.alpha_rad[0], 0.3, 1e-15);
+  EXPECT_NEAR(m.cloud.beta_rad[0], -3.0, 1e-15);
+  EXPECT_FLOAT_EQ(m.cloud.intensity[2], 70.0f);
+  EXPECT_EQ(m.cloud.viewpoint, c.viewpoint);
+  // No attributes in, none out.
+  Cloud bare;
+  bare.points = c.points;
+  const VoxelMeans b = voxelMeans(bare, 0.1);
+  EXPECT_EQ(b.cloud.points, m.cloud.points);
+  EXPECT_TRUE(b.cloud.intensity.empty());
+  EXPECT_FALSE(b.cloud.hasScanAngles());
+  EXPECT_TRUE(voxelMeans(Cloud{}, 0.1).cloud.empty());
+}
+
+TEST(VoxelMeans, RejectsABadVoxelAndAnAttributeOfTheWrongLength) {
+  Cloud c;
+  c.points = {Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  for (double bad : {0.0, -0.1, std::numeric_limits<double>::infinity(), std::nan("")}) {
+    try {
+      voxelMeans(c, bad);
+      ADD_FAILURE() << "voxel " << bad << " accepted";
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("[voxelMeans] voxel must be > 0 and finite"), std::string::npos) << e.what();
+    }
+  }
+  c.intensity = {1.0f};
+  try {
+    voxelMeans(c, 0.1);
+    ADD_FAILURE() << "a short intensity was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_STREQ(e.what(), "[voxelMeans] an attribute has 1 values for 2 points");
+  }
 }
 
 // The binned selection against a plain sort by (distance², slot), on squared
