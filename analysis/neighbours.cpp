@@ -662,19 +662,34 @@ bool medianNeighbourDistanceBelow(const std::vector<Vec3>& points, double limit_
   // A point nearer than limit_m lies in one of the 27 cells around the sample's; the
   // cells are a hair wider so that rounding in the cell index cannot push it further.
   const double cell = limit_m * (1 + 1e-9);
-  KeyIds ids(n / 4);
-  std::vector<uint32_t> cell_of(n);
-  for (size_t i = 0; i < n; ++i) cell_of[i] = ids.idOf(voxelKey(points[i], cell));
-  std::vector<uint32_t> start(ids.size() + 1, 0), members(n);
-  for (uint32_t c : cell_of) ++start[c + 1];
-  for (size_t c = 0; c < ids.size(); ++c) start[c + 1] += start[c];
-  {
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-    for (uint32_t i = 0; i < n; ++i) members[fill[cell_of[i]]++] = i;
-  }
   // The same samples as medianNeighbourDistance; the median is the (m/2)-th smallest
   // of their m distances, below the limit when more than m/2 of them are.
   const size_t step = std::max<size_t>(1, n / std::max<size_t>(1, samples));
+  // Only the cells around the samples are read: a table of those few thousand keys
+  // stays in cache while every point is looked up in it once.
+  KeyIds ids(27 * (n / step + 1));
+  for (size_t i = 0; i < n; i += step) {
+    const Eigen::Vector3i c = voxelOf(points[i], cell);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) ids.idOf(voxelKey(Eigen::Vector3i(c.x() + dx, c.y() + dy, c.z() + dz)));
+  }
+  constexpr uint32_t kElsewhere = std::numeric_limits<uint32_t>::max();
+  std::vector<uint32_t> cell_of(n, kElsewhere), start(ids.size() + 1, 0);
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t id = 0;
+    if (ids.find(voxelKey(points[i], cell), id)) {
+      cell_of[i] = id;
+      ++start[id + 1];
+    }
+  }
+  for (size_t c = 0; c < ids.size(); ++c) start[c + 1] += start[c];
+  std::vector<uint32_t> members(start.back());
+  {
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (uint32_t i = 0; i < n; ++i)
+      if (cell_of[i] != kElsewhere) members[fill[cell_of[i]]++] = i;
+  }
   size_t m = 0, below = 0;
   for (size_t i = 0; i < n; i += step) {
     ++m;
