@@ -214,8 +214,10 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), w);
   }
 
-  // How many scan points each working point stands for (empty: one each).
+  // How many scan points each working point stands for (empty: one each), and the
+  // scan's own sail points when the working points are voxel means.
   std::vector<uint32_t> represents;
+  std::vector<Vec3> scan_points;
   // The neighbour table of the working points, when segmentation's gives it.
   bool reuse_table = false;
   if (const double voxel = workingVoxel(cloud, p); voxel > 0) {
@@ -227,6 +229,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
       // Segmentation's own voxels: every scan point in its sail voxels went to the
       // sail, so their means are the working points already.
       if (enough(sail_voxels.size())) {
+        scan_points = std::move(cloud.points);
         cloud = selectPoints(sample.cloud, sail_voxels);
         for (uint32_t v : sail_voxels) represents.push_back(sample.count[v]);
         a.working_voxel_m = voxel;
@@ -235,6 +238,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     } else {
       VoxelMeans merged = voxelMeans(cloud, voxel);
       if (enough(merged.cloud.size())) {
+        scan_points = std::move(cloud.points);
         cloud = std::move(merged.cloud);
         represents = std::move(merged.count);
         a.working_voxel_m = voxel;
@@ -330,7 +334,14 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
   }
   {
     StageTimer t(a, "outline", a.mesh.vertices.size());
-    a.outline = extractOutline(a.mesh, p.outline, loose);
+    // A voxel mean at a narrow tip lies up to half a voxel short of the tip's outermost
+    // samples: the corners read the scan's own points, at the scan's density.
+    double sample_density = 0;
+    if (!scan_points.empty()) {
+      loose.insert(loose.end(), scan_points.begin(), scan_points.end());
+      sample_density = static_cast<double>(a.sail_points) / std::max(1e-12, meshArea(a.mesh));
+    }
+    a.outline = extractOutline(a.mesh, p.outline, loose, sample_density);
     a.luff = measureLuffCurve(a.outline);
     t.finish(a.outline.boundary.size(), a.outline.warnings);
   }

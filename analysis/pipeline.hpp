@@ -27,15 +27,18 @@ struct AnalysisParams {
   // scan is denser (0: full resolution), so normals and curvature see the same
   // neighbourhood size relative to the noise whatever the scanner's density.
   double segmentation_voxel_sigmas = 5.0;
-  // The working resolution. After segmentation a scan with two samples or more per voxel
+  // The working resolution, a trade of accuracy for speed (0: off, the default). With
+  // working_voxel_sigmas > 0, after segmentation a scan with two samples or more per voxel
   // on average goes on as one point per occupied voxel, the mean of its samples (and of
-  // their attributes). Samples closer than a few sensor σ add no shape the noise lets
-  // through, only more noise to average, and every later stage's cost grows with the
-  // points. The voxel is this many sensor σ wide (0: every scan point goes on), but never
-  // wider than working_voxel_of_extent times the sail's bounding-box diagonal, so a
-  // model-scale sail keeps its detail: the accuracy targets are met on 40,000-point
-  // scans of a 10 m sail, whose samples lie 2.2 cm (1/480 of its 10.6 m diagonal) apart.
-  double working_voxel_sigmas = 5.0;
+  // their attributes); the corners still read the scan's own outermost samples. The voxel
+  // is this many sensor σ wide, but never wider than working_voxel_of_extent times the
+  // sail's bounding-box diagonal, so a model-scale sail keeps its detail (the accuracy
+  // targets are met on 40,000-point scans of a 10 m sail, 2.2 cm or 1/480 of its 10.6 m
+  // diagonal apart). At 5 (2 cm) a 200,000-point scan is analysed about 3 times as fast,
+  // but a voxel mean along an edge lies inside it: on dense scans of sails made apart
+  // from our generator, entry angles came out up to 3° off where every point gives
+  // under 1.7° (bench/README.md, 2026-11-23).
+  double working_voxel_sigmas = 0;
   double working_voxel_of_extent = 1.0 / 500;
   RegionGrowingParams region_growing;
   SailPickParams sail_pick;

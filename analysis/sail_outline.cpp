@@ -928,7 +928,8 @@ Vec3 pointAtFraction(const std::vector<Vec3>& line, double fraction) {
   return line.back();
 }
 
-SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::vector<Vec3>& loose_points) {
+SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::vector<Vec3>& loose_points,
+                           double sample_density_per_m2) {
   if (mesh.triangles.empty()) throw InvalidInput("[extractOutline] empty mesh");
   if (p.corners != 0 && p.corners != 3 && p.corners != 4)
     throw InvalidInput("[extractOutline] corners must be 0 (auto), 3 or 4 (got " + std::to_string(p.corners) + ")");
@@ -1091,7 +1092,9 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   if (out.has_peak) top = makeEdge(head, peak);
   const double sp = out.boundary_spacing_m;
   const double mesh_area = meshArea(mesh);
-  const double density = static_cast<double>(mesh.vertices.size()) / std::max(1e-12, mesh_area);
+  const double density = sample_density_per_m2 > 0
+                             ? sample_density_per_m2
+                             : static_cast<double>(mesh.vertices.size()) / std::max(1e-12, mesh_area);
   const double reach = std::max(0.05 * total, 10.0 * sp);
   auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start) {
     const Vec3 c = placeCorner(meetEdges(a, a_start, b, b_start, sp, samples), mesh, tree, loose_points, density, reach, sp);

@@ -44,8 +44,11 @@ struct SailOutline {
 // `loose_points`: points of the sail the mesh left out (a lone sample near a
 // narrow tip whose triangles were trimmed as too long); a corner reaches at
 // least to those of them that lie inside both its edges and on the surface.
+// `sample_density_per_m2`: the density the outermost samples near a corner were
+// taken at, when the loose points are the scan's own and the mesh's vertices are
+// fewer (voxel means); 0: the mesh's vertices per square metre.
 SailOutline extractOutline(const Mesh& mesh, const OutlineParams& params = {},
-                           const std::vector<Vec3>& loose_points = {});
+                           const std::vector<Vec3>& loose_points = {}, double sample_density_per_m2 = 0);
 
 // Length of a polyline, m.
 double polylineLength(const std::vector<Vec3>& line);

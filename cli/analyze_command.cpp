@@ -122,7 +122,7 @@ void addAnalyzeCommand(CLI::App& app) {
       ->check(CLI::IsMember({"normal", "perpendicular", "horizontal"}));
   cmd->add_option("--json", opt->json_out, "Write the full result as JSON to this file instead of the table");
   cmd->add_option("--mesh", opt->mesh_out, "Write the reconstructed sail surface (.ply, .obj or .stl)");
-  cmd->add_option("--sail-cloud", opt->cloud_out, "Write the segmented, cleaned and smoothed sail points (one per working voxel on a dense scan)");
+  cmd->add_option("--sail-cloud", opt->cloud_out, "Write the segmented, cleaned and smoothed sail points (one per voxel at a working resolution)");
   cmd->add_option("--params", opt->params_file, "Pipeline parameters file (.json, .yaml or .yml); see --print-params");
   cmd->add_option("--corners", opt->corners, "Corners of the sail: 3, 4 (square top) or 0 for automatic")
       ->check(CLI::IsMember({0, 3, 4}));

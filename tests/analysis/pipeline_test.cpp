@@ -368,23 +368,26 @@ TEST(Pipeline, NoisyJibMeetsTheTargetsWithItsTackOnTheSurface) {
 }
 
 TEST(Pipeline, DenseNoisyMainsailKeepsItsEndAnglesWithinTheNoiseTargets) {
-  // Five times denser than above, analysed at full resolution: more points must
-  // not make it worse. The MLS neighbourhood (a fixed count) then spans a smaller
+  // Five times denser than above, every point analysed (the default): more points
+  // must not make it worse. The MLS neighbourhood (a fixed count) then spans a smaller
   // patch, and an edge point's one-sided quadratic tilts with the noise; on this
   // seed the top section's exit came out 3.8° off when edge fits used k points, not 2k.
   const SailDesign design = exampleDesign(SailType::Main);
   const ScanSimulation sim = scan(200000, 3, 0.004);
-  AnalysisParams p;
-  p.working_voxel_sigmas = 0;
-  const SailAnalysis a = analyzeSail(sampleSail(design, sim), p);
+  const SailAnalysis a = analyzeSail(sampleSail(design, sim));
   EXPECT_EQ(a.working_voxel_m, 0.0);
   EXPECT_EQ(a.working_points, a.sail_points);
   EXPECT_GE(a.mesh.vertices.size(), a.sail_points * 999 / 1000);
   expectNoisyTargets(a, design);
 }
 
-// The working resolution's voxel, 5 sensor σ wide, never wider than 1/500 of the
-// sail's bounding-box diagonal (pipeline.hpp).
+// The working resolution asked for at 5 sensor σ: its voxel is never wider than
+// 1/500 of the sail's bounding-box diagonal (pipeline.hpp).
+AnalysisParams workingResolution() {
+  AnalysisParams p;
+  p.working_voxel_sigmas = 5;
+  return p;
+}
 double expectedWorkingVoxel(const Cloud& sail) {
   Eigen::AlignedBox3d box;
   for (const Vec3& x : sail.points) box.extend(x);
@@ -403,14 +406,14 @@ void expectWorkingResolution(const SailAnalysis& a, const Cloud& scan) {
 }
 
 TEST(Pipeline, ADenseNoisyScanIsAnalysedAtTheWorkingResolutionWithinTheNoiseTargets) {
-  // 200,000 samples of a 10 m main and of a jib, 4 mm noise: the stages after
-  // segmentation work on one mean per voxel of about 2 cm (3 samples each), and
-  // meet the noise targets as the full resolution does.
+  // 200,000 samples of a 10 m main and of a jib, 4 mm noise, at the working
+  // resolution: the stages after segmentation work on one mean per voxel of about
+  // 2 cm (3 samples each), and meet the noise targets here.
   for (SailType type : {SailType::Main, SailType::Jib}) {
     SCOPED_TRACE(type == SailType::Main ? "main" : "jib");
     const SailDesign design = exampleDesign(type);
     const Cloud cloud = sampleSail(design, scan(200000, 4, 0.004));
-    const SailAnalysis a = analyzeSail(cloud);
+    const SailAnalysis a = analyzeSail(cloud, workingResolution());
     expectWorkingResolution(a, cloud);
     EXPECT_GT(a.working_voxel_m, 0.015);
     expectNoisyTargets(a, design);
@@ -423,7 +426,7 @@ TEST(Pipeline, ADenseCleanModelSailIsMergedNoCoarserThanAFiveHundredthOfItsSize)
   // and the clean targets hold.
   const SailDesign design = scaleDesign(exampleDesign(SailType::Main), 0.2);
   const Cloud cloud = sampleSail(design, scan(150000, 5));
-  const SailAnalysis a = analyzeSail(cloud);
+  const SailAnalysis a = analyzeSail(cloud, workingResolution());
   expectWorkingResolution(a, cloud);
   EXPECT_LT(a.working_voxel_m, 0.005);
   expectSectionsMatch(a, SailSurface(design), kClean);
@@ -433,7 +436,7 @@ TEST(Pipeline, ScansUnderTwoSamplesAVoxelGoOnAtFullResolution) {
   // 40,000 samples of a 10 m main hold about 1.4 per 2 cm voxel: the mean of one or
   // two samples is no better a point, so every sample goes on.
   const Cloud cloud = sampleSail(exampleDesign(SailType::Main), scan(40000, 6, 0.004));
-  const SailAnalysis a = analyzeSail(cloud);
+  const SailAnalysis a = analyzeSail(cloud, workingResolution());
   EXPECT_EQ(a.working_voxel_m, 0.0);
   EXPECT_EQ(a.working_points, a.sail_points);
   EXPECT_GE(a.sail_points, cloud.size() * 98 / 100);
