@@ -217,6 +217,24 @@ TEST(SailOutline, AHeadReachesTheLooseSampleTheMeshLeftOut) {
   }
 }
 
+// The corners read the tip's gap at the density the loose samples were taken at
+// (a working resolution's mesh is sparser than its scan). An empty wedge beyond the
+// outermost sample is the less likely the denser the scan: at a vast density the head
+// lands on the lone sample itself; at the mesh's own density it lies beyond it.
+TEST(SailOutline, TheDenserTheLooseSamplesTheCloserTheHeadToTheOutermost) {
+  const SailSurface truth(exampleDesign(SailType::Main));
+  const LoneTip cut = mainWithABareHead(0.50);
+  ASSERT_LT(cut.tip_distance_m, 0.05) << "the sampling left no sample near the head";
+  const Mesh mesh = reconstructSurface(cut.rest).mesh;
+  const Vec3 up = (truth.head() - 0.5 * (truth.luffPoint(0.98) + truth.leechPoint(0.98))).normalized();
+  const SailOutline own = extractOutline(mesh, {}, {cut.tip});
+  const SailOutline dense = extractOutline(mesh, {}, {cut.tip}, 1e9);
+  EXPECT_NEAR((dense.head - cut.tip).dot(up), 0.0, 0.002) << "head " << dense.head.transpose();
+  EXPECT_GT((own.head - cut.tip).dot(up), (dense.head - cut.tip).dot(up) + 0.002);
+  // 0 stands for the mesh's own density.
+  EXPECT_EQ(extractOutline(mesh, {}, {cut.tip}, 0.0).head, own.head);
+}
+
 // The same head with its last 12 cm bare and no lone sample at all: the luff and
 // leech, placed by the outermost samples beside them and carried on to where
 // they cross, put the head within half a sample spacing of the true one. (Their
