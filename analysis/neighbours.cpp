@@ -797,7 +797,6 @@ double selectNearest(const std::vector<double>& d2, double limit2, size_t k, std
   return t;
 }
 
-
 VoxelMeans voxelMeans(const Cloud& in, double voxel_m) {
   if (!(voxel_m > 0) || !std::isfinite(voxel_m))
     throw InvalidInput("[voxelMeans] voxel must be > 0 and finite (got " + std::to_string(voxel_m) + " m)");
