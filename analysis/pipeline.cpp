@@ -36,8 +36,7 @@ double workingVoxel(const Cloud& sail, const AnalysisParams& p) {
   if (!(p.working_voxel_sigmas > 0) || sail.size() < 2) return 0;
   Eigen::AlignedBox3d box;
   for (const Vec3& x : sail.points) box.extend(x);
-  return std::min(p.working_voxel_sigmas * p.sensor_sigma_m,
-                  std::max(0.0, p.working_voxel_of_extent) * box.diagonal().norm());
+  return std::min(p.working_voxel_sigmas * p.sensor_sigma_m, p.working_voxel_of_extent * box.diagonal().norm());
 }
 
 // The working resolution pays only where the voxels hold several samples each: at
@@ -165,6 +164,12 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
       throw InvalidInput("[analyzeSail] point " + std::to_string(i) + " has a non-finite coordinate");
   if (!(p.sensor_sigma_m > 0))
     throw InvalidInput("[analyzeSail] sensor_sigma_m must be > 0 (got " + std::to_string(p.sensor_sigma_m) + ")");
+  if (!(p.working_voxel_sigmas >= 0) || !std::isfinite(p.working_voxel_sigmas))
+    throw InvalidInput("[analyzeSail] working_voxel_sigmas must be >= 0 and finite (0: every point; got " +
+                       std::to_string(p.working_voxel_sigmas) + ")");
+  if (!(p.working_voxel_of_extent > 0) || !std::isfinite(p.working_voxel_of_extent))
+    throw InvalidInput("[analyzeSail] working_voxel_of_extent must be > 0 and finite (got " +
+                       std::to_string(p.working_voxel_of_extent) + ")");
   {  // the sections come last: a bad parameter of theirs is reported before the work, not after
     SectionParams sp = p.sections;
     sp.sensor_sigma_m = p.sensor_sigma_m;

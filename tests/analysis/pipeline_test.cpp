@@ -846,6 +846,14 @@ TEST(Pipeline, ABadSectionParameterIsReportedBeforeAnyWork) {
   p.sections.curve_points = 61;
   p.sections.max_tilt_deg = 90;
   expectThrowWith<InvalidInput>([&] { analyzeSail(wall, p); }, {"[cutSections]", "max_tilt_deg must be in (0, 90)"});
+  // A working resolution below zero is a mistake, not "off".
+  p.sections.max_tilt_deg = 45;
+  p.working_voxel_sigmas = -5;
+  expectThrowWith<InvalidInput>([&] { analyzeSail(wall, p); },
+                                {"[analyzeSail]", "working_voxel_sigmas must be >= 0", "-5"});
+  p.working_voxel_sigmas = 5;
+  p.working_voxel_of_extent = 0;
+  expectThrowWith<InvalidInput>([&] { analyzeSail(wall, p); }, {"[analyzeSail]", "working_voxel_of_extent must be > 0"});
 }
 
 TEST(Pipeline, ACleanWindTunnelModelKeepsItsTopSectionWithinTheCleanTargets) {
