@@ -10,6 +10,9 @@
 #include "analysis/neighbours.hpp"
 #include "analysis/plane_detection.hpp"
 
+#include <CGAL/Gmpzf.h>
+#include <CGAL/QP_functions.h>
+#include <CGAL/QP_models.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
@@ -226,6 +229,7 @@ struct Edge {
   // The spacing of scan lines running beside the edge, when its samples lie on such
   // lines (GapShape; 0: a scatter): the edge lies up to one beyond the last line.
   double line_spacing = 0;
+  bool along_lines = false;  // its curve runs along its samples' lower envelope (lowerEnvelope)
   double sigma = 0;           // 1σ position uncertainty of the fitted curve
   double scatter = 0;         // RMS distance of the points from the fitted curve, m
 };
@@ -389,6 +393,52 @@ GapShape gapShape(std::vector<std::pair<double, double>> along_offset, double wi
 // and 1.71 from 3,424; luffs on scan lines read 2.1 (3,172 gaps) to 9.3 (5,069).
 bool onScanLines(const GapShape& g) { return g.gaps > 0 && g.ratio() > 1.5 + 30.0 / std::sqrt(g.gaps); }
 
+// The lower envelope of samples (s, o) (o positive inwards): the polynomial of the
+// given degree that lies beyond (o below) the outermost sample of every stretch
+// `window` long and is as far in as that allows on the whole (a linear programme:
+// maximise Σ p(s_w) subject to p(s_w) ≤ least_w, solved exactly by CGAL). Where scan
+// lines cross an edge, each line ends on it, so the envelope touches the line ends
+// and is the edge; a fit through the outermost samples would follow the staircase
+// the last line leaves between crossings. nullopt when the programme has no optimum.
+std::optional<Polynomial> lowerEnvelope(std::vector<std::pair<double, double>> along_offset, double window, int degree) {
+  std::sort(along_offset.begin(), along_offset.end());
+  std::vector<double> s, least;
+  for (size_t a = 0; a < along_offset.size();) {
+    size_t b = a, at = a;
+    while (b < along_offset.size() && along_offset[b].first < along_offset[a].first + window) {
+      if (along_offset[b].second < along_offset[at].second) at = b;
+      ++b;
+    }
+    s.push_back(along_offset[at].first);
+    least.push_back(along_offset[at].second);
+    a = b;
+  }
+  degree = std::min(degree, static_cast<int>(s.size() / 4) - 1);
+  if (degree < 1) return std::nullopt;
+  Polynomial p;
+  p.mid = 0.5 * (s.front() + s.back());
+  p.half = std::max(1e-9, 0.5 * (s.back() - s.front()));
+  CGAL::Quadratic_program<double> lp(CGAL::SMALLER, false, 0, false, 0);
+  std::vector<double> objective(static_cast<size_t>(degree) + 1, 0.0);
+  for (size_t w = 0; w < s.size(); ++w) {
+    const double u = (s[w] - p.mid) / p.half;
+    double uk = 1;
+    for (int k = 0; k <= degree; ++k, uk *= u) {
+      lp.set_a(k, static_cast<int>(w), uk);
+      objective[static_cast<size_t>(k)] -= uk;
+    }
+    lp.set_b(static_cast<int>(w), least[w]);
+  }
+  for (int k = 0; k <= degree; ++k) lp.set_c(k, objective[static_cast<size_t>(k)]);
+  const CGAL::Quadratic_program_solution<CGAL::Gmpzf> solution = CGAL::solve_linear_program(lp, CGAL::Gmpzf());
+  if (!solution.is_optimal()) return std::nullopt;
+  p.coeffs = Eigen::MatrixXd::Zero(degree + 1, 1);
+  int k = 0;
+  for (auto it = solution.variable_values_begin(); it != solution.variable_values_end(); ++it, ++k)
+    p.coeffs(k, 0) = CGAL::to_double(*it);
+  return p;
+}
+
 // A sampled surface's boundary lies inside the true edge: the outermost samples
 // sit some distance in. Sample offsets from the true edge are uniform on
 // [0, ∞), so within the strip o ≤ D of the found edge (offset o from it,
@@ -510,6 +560,63 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
   e.scatter = sigma_res;
   const double sigma_curve = sigma_res * std::sqrt(static_cast<double>(degree + 1) / static_cast<double>(inner.size()));
   e.sigma = std::hypot(sigma_curve, sigma_recess);
+  if (e.line_spacing > 0) {
+    // The edge through the lines' ends: the samples' lower envelope along the whole
+    // edge, up to the corners (the fitted curve's straight continuation is the
+    // reference beyond its range; the other edge's samples near a corner lie inside
+    // and do not count). Where the boundary cuts into the sail (a line left out of
+    // the mesh), the 24 vertices round it lie on both sides and the inward direction
+    // can turn over: those stretches are left out.
+    auto reference = [&](double s_at) {
+      const double sc = std::clamp(s_at, e.exclude, e.length - e.exclude);
+      return Vec3(e.curve.at(sc) + (s_at - sc) * e.curve.tangent(sc));
+    };
+    Vec3 inward_mean = Vec3::Zero();
+    for (size_t i : inner) inward_mean += inward[i];
+    std::vector<std::pair<double, double>> beside;
+    std::fill(seen.begin(), seen.end(), 0);
+    for (size_t i = 0; i < e.points.size(); i += 2) {
+      if (inward[i].dot(inward_mean) <= 0) continue;
+      const Vec3 c = reference(e.s[i]), t = e.curve.tangent(std::clamp(e.s[i], e.exclude, e.length - e.exclude));
+      tree.withinRadius(c, std::hypot(strip, spacing), idx, d2);
+      for (uint32_t v : idx) {
+        if (seen[v]) continue;
+        const Vec3 d = mesh.vertices[v] - c;
+        if (std::abs(d.dot(t)) > spacing) continue;
+        seen[v] = 1;
+        const double o = d.dot(inward[i]);
+        // Two line spacings beyond the curve is a stray, not a line's end.
+        if (o <= strip && o >= -2.0 * e.line_spacing) beside.emplace_back(e.s[i] + d.dot(t), o);
+      }
+    }
+    const std::optional<Polynomial> envelope = lowerEnvelope(beside, spacing, degree);
+    // It lies within a line spacing and a half beyond the curve through the boundary
+    // and no more than half a spacing inside it; further off, the boundary is not the
+    // lines' (it cut into the sail or left it) and the edge is placed as a scatter's.
+    bool plausible = envelope.has_value();
+    const double first = envelope ? envelope->mid - envelope->half : 0, last = envelope ? envelope->mid + envelope->half : 0;
+    for (size_t i : inner) {
+      if (!plausible) break;
+      const double p = envelope->at(std::clamp(e.s[i], first, last))[0];
+      plausible = p >= -1.5 * e.line_spacing && p <= 0.5 * e.line_spacing;
+    }
+    if (plausible) {
+      // The curve between the corners, which the sections end on, runs along the
+      // envelope; the corners keep the scatter's placement of the points near them
+      // (placed from the envelope's ends, which it holds beyond the samples, heads
+      // and clews moved up to 16 cm, as often worse as better).
+      e.along_lines = true;
+      std::vector<Vec3> pts;
+      std::vector<double> at;
+      for (size_t i : inner) {
+        const double p = envelope->at(std::clamp(e.s[i], first, last))[0];
+        const Vec3 normal = inward[i].cross(e.curve.tangent(e.s[i]));
+        pts.push_back(reference(e.s[i]) + p * inward[i] + (e.points[i] - reference(e.s[i])).dot(normal) * normal);
+        at.push_back(e.s[i]);
+      }
+      e.curve = fitEdgeCurve(pts, at, degree);
+    }
+  }
 }
 
 // A quadratic through an edge's points near one of its corners, as a function
@@ -1178,10 +1285,12 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   for (const auto& [name, e] : {std::pair<const char*, const Edge*>{"luff", &luff}, {"leech", &leech}, {"foot", &foot},
                                 {"top edge", &top}})
     if (e->line_spacing > 0)
-      out.warnings.push_back(std::string(name) + ": its samples lie on scan lines running beside it, about " +
-                             formatFixed(100 * e->line_spacing, 1) +
-                             " cm apart (a cloud without its scan angles?); the edge is placed by the last line, up to a "
-                             "line spacing inside it, and the corners at its ends may lie further off than that");
+      out.warnings.push_back(
+          std::string(name) + ": its samples lie on scan lines running beside it, about " +
+          formatFixed(100 * e->line_spacing, 1) + " cm apart (a cloud without its scan angles?); " +
+          (e->along_lines ? "the edge runs through the lines' ends and between them is known to a line spacing"
+                          : "the edge is placed by the last line, up to a line spacing inside it") +
+          ", and the corners at its ends may lie further off than that");
   out.luff = edgePolyline(luff, out.tack, out.head, sp);
   out.foot = edgePolyline(foot, out.tack, out.clew, sp);
   out.leech = edgePolyline(leech, out.clew, out.has_peak ? out.peak : out.head, sp);

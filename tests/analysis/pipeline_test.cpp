@@ -581,6 +581,26 @@ TEST(Pipeline, ALuffBesideScanLinesIsSaidSoAndItsUncertaintyCoversALineSpacing) 
   }
 }
 
+// Where the rake carries the luff over a scan line, the line ends on it: the edge
+// runs through those ends, outside the staircase the last line leaves between
+// them (up to 6 cm inside here). Placed by the outermost samples as a scatter's,
+// the luff came out 1.0 cm inside on both sails; through the ends, 0.1-0.2 cm.
+TEST(Pipeline, ALuffCrossingItsScanLinesRunsThroughTheirEnds) {
+  for (SailType type : {SailType::Main, SailType::SquareTopMain}) {
+    SCOPED_TRACE(sailTypeName(type));
+    const SailDesign design = exampleDesign(type);
+    const SailSurface truth(design);
+    const SailAnalysis a = analyzeSail(sampleOnScanLines(truth, Vec3(-2.5, -8.0, 5.0), 0.06 / 8.5, 0.02));
+    ASSERT_TRUE(warnsOfScanLinesBeside(a, "luff"));
+    ASSERT_EQ(a.sections.sections.size(), 3u);
+    for (const Section& s : a.sections.sections) {
+      const KnownSection k = truth.section(s.fraction);
+      const Vec3 along_chord = (k.leech_point - k.luff_point).normalized();
+      EXPECT_LT(std::abs((s.luff_point - k.luff_point).dot(along_chord)), 0.005) << "section " << s.fraction;
+    }
+  }
+}
+
 TEST(Pipeline, AUniformScatterIsNotTakenForScanLines) {
   const SailDesign design = exampleDesign(SailType::Main);
   for (const auto& [points, noise_m] : {std::pair{40000, 0.0}, {40000, 0.004}, {5000, 0.004}}) {
