@@ -253,6 +253,19 @@ double recessFromLeast(double least, double D, double n) {
 constexpr double kFrontierStripSpacings = 4.0, kFrontierWindowSpacings = 5.0;
 constexpr double kFrontierFewestWindows = 8.0;
 
+// Calls f(a, b) for each run [a, b) of `sorted` (samples (arc position, offset) in
+// ascending arc position) that starts where the last one ended and reaches less than
+// `window` along from its first sample; each holds one sample at least.
+template <typename F>
+void forEachWindow(const std::vector<std::pair<double, double>>& sorted, double window, F&& f) {
+  for (size_t a = 0; a < sorted.size();) {
+    size_t b = a + 1;
+    while (b < sorted.size() && sorted[b].first < sorted[a].first + window) ++b;
+    f(a, b);
+    a = b;
+  }
+}
+
 struct Frontier {
   double recess = 0;                  // m
   size_t windows = 0;
@@ -270,16 +283,13 @@ Frontier frontierRecess(std::vector<std::pair<double, double>> along_offset, dou
     size_t n;
   };
   std::vector<Window> windows;
-  for (size_t a = 0; a < along_offset.size();) {
-    size_t b = a;
+  forEachWindow(along_offset, window, [&](size_t a, size_t b) {
     double least = std::numeric_limits<double>::infinity();
-    while (b < along_offset.size() && along_offset[b].first < along_offset[a].first + window)
-      least = std::min(least, along_offset[b++].second);
+    for (size_t j = a; j < b; ++j) least = std::min(least, along_offset[j].second);
     if (b - a >= 8)
       windows.push_back({0.5 * (along_offset[a].first + along_offset[b - 1].first),
                          along_offset[b - 1].first - along_offset[a].first, least, b - a});
-    a = b;
-  }
+  });
   if (windows.empty()) return f;
   // Samples per full window: the median count (near a narrow corner the strip
   // reaches across the sail and holds fewer, though the outermost lies as close).
@@ -362,22 +372,18 @@ GapShape gapShape(std::vector<std::pair<double, double>> along_offset, double wi
   std::sort(along_offset.begin(), along_offset.end());
   double sum = 0, sum2 = 0, gaps = 0;
   std::vector<double> o;
-  for (size_t a = 0; a < along_offset.size();) {
-    size_t b = a;
+  forEachWindow(along_offset, window, [&](size_t a, size_t b) {
+    if (b - a < 8) return;
     o.clear();
-    while (b < along_offset.size() && along_offset[b].first < along_offset[a].first + window)
-      o.push_back(along_offset[b++].second);
-    if (o.size() >= 8) {
-      std::sort(o.begin(), o.end());
-      for (size_t j = 1; j < o.size(); ++j) {
-        const double gap = o[j] - o[j - 1];
-        sum += gap;
-        sum2 += gap * gap;
-        gaps += 1;
-      }
+    for (size_t j = a; j < b; ++j) o.push_back(along_offset[j].second);
+    std::sort(o.begin(), o.end());
+    for (size_t j = 1; j < o.size(); ++j) {
+      const double gap = o[j] - o[j - 1];
+      sum += gap;
+      sum2 += gap * gap;
+      gaps += 1;
     }
-    a = b;
-  }
+  });
   if (gaps > 0 && sum > 0) {
     g.mean_gap = sum / gaps;
     g.residual = sum2 / (2.0 * sum);
@@ -403,16 +409,13 @@ bool onScanLines(const GapShape& g) { return g.gaps > 0 && g.ratio() > 1.5 + 30.
 std::optional<Polynomial> lowerEnvelope(std::vector<std::pair<double, double>> along_offset, double window, int degree) {
   std::sort(along_offset.begin(), along_offset.end());
   std::vector<double> s, least;
-  for (size_t a = 0; a < along_offset.size();) {
-    size_t b = a, at = a;
-    while (b < along_offset.size() && along_offset[b].first < along_offset[a].first + window) {
-      if (along_offset[b].second < along_offset[at].second) at = b;
-      ++b;
-    }
+  forEachWindow(along_offset, window, [&](size_t a, size_t b) {
+    size_t at = a;
+    for (size_t j = a + 1; j < b; ++j)
+      if (along_offset[j].second < along_offset[at].second) at = j;
     s.push_back(along_offset[at].first);
     least.push_back(along_offset[at].second);
-    a = b;
-  }
+  });
   degree = std::min(degree, static_cast<int>(s.size() / 4) - 1);
   if (degree < 1) return std::nullopt;
   Polynomial p;
