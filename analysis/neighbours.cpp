@@ -797,42 +797,88 @@ double selectNearest(const std::vector<double>& d2, double limit2, size_t k, std
   return t;
 }
 
-VoxelMeans voxelMeans(const Cloud& in, double voxel_m) {
-  if (!(voxel_m > 0) || !std::isfinite(voxel_m))
-    throw InvalidInput("[voxelMeans] voxel must be > 0 and finite (got " + std::to_string(voxel_m) + " m)");
+namespace {
+
+// One point per cell: the mean of the points of `in` that cell_of puts in it and of
+// each attribute they carry. Cells are numbered 0 .. cells - 1; `who` names the caller
+// in errors.
+VoxelMeans meansOver(const Cloud& in, std::vector<uint32_t> cell_of, size_t cells, const char* who) {
   VoxelMeans out;
   out.cloud.viewpoint = in.viewpoint;
-  out.voxel_of.resize(in.size());
-  KeyIds index(in.size() / 4);
-  std::vector<Vec3> sum;
+  out.voxel_of = std::move(cell_of);
+  out.count.assign(cells, 0);
+  std::vector<Vec3> sum(cells, Vec3::Zero());
   for (size_t i = 0; i < in.size(); ++i) {
-    const uint32_t v = index.idOf(voxelKey(in.points[i], voxel_m));
-    if (v == sum.size()) {
-      sum.push_back(Vec3::Zero());
-      out.count.push_back(0);
-    }
-    sum[v] += in.points[i];
-    ++out.count[v];
-    out.voxel_of[i] = v;
+    sum[out.voxel_of[i]] += in.points[i];
+    ++out.count[out.voxel_of[i]];
   }
-  const size_t n = sum.size();
-  out.cloud.points.resize(n);
-  for (size_t v = 0; v < n; ++v) out.cloud.points[v] = sum[v] / static_cast<double>(out.count[v]);
+  out.cloud.points.resize(cells);
+  for (size_t v = 0; v < cells; ++v) out.cloud.points[v] = sum[v] / static_cast<double>(out.count[v]);
   auto average = [&](const auto& values, auto& means) {
     if (values.empty()) return;
     if (values.size() != in.size())
-      throw InvalidInput("[voxelMeans] an attribute has " + std::to_string(values.size()) + " values for " +
+      throw InvalidInput(std::string("[") + who + "] an attribute has " + std::to_string(values.size()) + " values for " +
                          std::to_string(in.size()) + " points");
-    std::vector<double> total(n, 0.0);
+    std::vector<double> total(cells, 0.0);
     for (size_t i = 0; i < in.size(); ++i) total[out.voxel_of[i]] += static_cast<double>(values[i]);
-    means.resize(n);
-    for (size_t v = 0; v < n; ++v)
+    means.resize(cells);
+    for (size_t v = 0; v < cells; ++v)
       means[v] = static_cast<typename std::decay_t<decltype(means)>::value_type>(total[v] / out.count[v]);
   };
   average(in.intensity, out.cloud.intensity);
   average(in.alpha_rad, out.cloud.alpha_rad);
   average(in.beta_rad, out.cloud.beta_rad);
   return out;
+}
+
+}  // namespace
+
+VoxelMeans voxelMeans(const Cloud& in, double voxel_m) {
+  if (!(voxel_m > 0) || !std::isfinite(voxel_m))
+    throw InvalidInput("[voxelMeans] voxel must be > 0 and finite (got " + std::to_string(voxel_m) + " m)");
+  KeyIds ids(in.size() / 4);
+  std::vector<uint32_t> cell_of(in.size());
+  for (size_t i = 0; i < in.size(); ++i) cell_of[i] = ids.idOf(voxelKey(in.points[i], voxel_m));
+  return meansOver(in, std::move(cell_of), ids.size(), "voxelMeans");
+}
+
+VoxelMeans columnMeans(const Cloud& in, const Eigen::Matrix3d& axes, double across_m, double max_depth_m) {
+  if (!(across_m > 0) || !std::isfinite(across_m) || !(max_depth_m >= 0) || !std::isfinite(max_depth_m))
+    throw InvalidInput("[columnMeans] need a column width > 0 and a depth >= 0, both finite (got " +
+                       std::to_string(across_m) + " m and " + std::to_string(max_depth_m) + " m)");
+  const Vec3 normal = axes.col(0);
+  // Plane coordinates scaled to columns one unit wide; the depth axis collapses.
+  Eigen::Matrix3d to_column = axes.transpose() / across_m;
+  to_column.row(0).setZero();
+  KeyIds ids(in.size() / 4);
+  std::vector<uint32_t> column_of(in.size());
+  std::vector<double> low, high;
+  for (size_t i = 0; i < in.size(); ++i) {
+    const uint32_t c = ids.idOf(voxelKey(to_column * in.points[i], 1.0));
+    const double depth = normal.dot(in.points[i]);
+    if (c == low.size()) {
+      low.push_back(depth);
+      high.push_back(depth);
+    }
+    low[c] = std::min(low[c], depth);
+    high[c] = std::max(high[c], depth);
+    column_of[i] = c;
+  }
+  // Cells in the order first met: a shallow column is one, a deep one a cell per point.
+  constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+  std::vector<uint32_t> cell_of_column(low.size(), kNone);
+  std::vector<uint32_t> cell_of(in.size());
+  uint32_t cells = 0;
+  for (size_t i = 0; i < in.size(); ++i) {
+    const uint32_t c = column_of[i];
+    if (high[c] - low[c] > max_depth_m) {
+      cell_of[i] = cells++;
+    } else {
+      if (cell_of_column[c] == kNone) cell_of_column[c] = cells++;
+      cell_of[i] = cell_of_column[c];
+    }
+  }
+  return meansOver(in, std::move(cell_of), cells, "columnMeans");
 }
 
 }  // namespace sailshape

@@ -135,6 +135,16 @@ struct VoxelMeans {
 };
 VoxelMeans voxelMeans(const Cloud& cloud, double voxel_m);
 
+// The same over square columns `across_m` wide standing on a plane (`axes`' columns:
+// col(0) its normal, as PrincipalAxes gives them). A cube voxel about as wide as the
+// range noise cuts a noisy surface's samples apart by their noise, and the means of
+// the parts lie off the surface by about ±0.8σ; a column holds the whole noise band.
+// A column whose points lie more than `max_depth_m` apart along the normal (the
+// surface steep in it, or two sheets over one another) is not merged: each of its
+// points is a cell of its own. Throws InvalidInput for a width that is not positive
+// and finite or a depth that is negative or not finite.
+VoxelMeans columnMeans(const Cloud& cloud, const Eigen::Matrix3d& axes, double across_m, double max_depth_m);
+
 // Of the slots j with d2[j] <= limit2, the k nearest by (distance², slot) into
 // `out`; returns the k-th distance², or -1 when fewer than k lie within limit2.
 // The squared distances are counted in bins of limit2 / kBins (a sample spread

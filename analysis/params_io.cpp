@@ -31,7 +31,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions,
                                                 normal_tolerance_deg, max_tilt_deg, max_iterations, normal_radius,
                                                 noise_correlation_m, curve_points, max_bridged_gap)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, normals, segment,
-                                                segmentation_voxel_sigmas, working_voxel_sigmas, working_voxel_of_extent, region_growing,
+                                                segmentation_voxel_sigmas, working_voxel_sigmas, working_column_depth_sigmas,
+                                                working_voxel_of_extent, region_growing,
                                                 sail_pick, find_spars, spars, statistical_outliers, statistical, radius_outliers, radius,
                                                 readmit_surface_points, readmit, smooth, smoothing, surface, outline, sections)
 

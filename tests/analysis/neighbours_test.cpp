@@ -562,6 +562,106 @@ TEST(VoxelMeans, RejectsABadVoxelAndAnAttributeOfTheWrongLength) {
   }
 }
 
+// A plane through `origin` spanned by unit u and v, sampled on a jittered grid
+// `spacing` apart over size × size, with Gaussian noise `sigma` along its normal.
+Cloud noisyPlane(const Vec3& origin, const Vec3& u, const Vec3& v, double size, double spacing, double sigma,
+                 unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(0, spacing);
+  std::normal_distribution<double> noise(0, sigma);
+  const Vec3 n = u.cross(v).normalized();
+  Cloud c;
+  for (double a = 0; a < size; a += spacing)
+    for (double b = 0; b < size; b += spacing) c.points.push_back(origin + (a + jitter(rng)) * u + (b + jitter(rng)) * v + noise(rng) * n);
+  return c;
+}
+
+// RMS distance of `points` from the plane through `origin` with normal n.
+double rmsOffPlane(const std::vector<Vec3>& points, const Vec3& origin, const Vec3& n) {
+  double ss = 0;
+  for (const Vec3& x : points) ss += std::pow(n.dot(x - origin), 2);
+  return std::sqrt(ss / static_cast<double>(points.size()));
+}
+
+TEST(ColumnMeans, AveragesTheWholeNoiseBandWhereCubeVoxelsCutItApart) {
+  // A 1 m plane with 4 mm noise, 25 samples per 2 cm column, lying on a face of the
+  // 2 cm cube grid (z = 0). A cube voxel then holds the samples on one side of the
+  // plane only, and its mean lies E|N(0, σ)| = 0.8σ off it; a column holds all 25 and
+  // its mean lies σ/5 off (RMS). Over 2,500 columns that RMS is known to about 1.5 %,
+  // and the bound allows 10 %.
+  const double sigma = 0.004;
+  const Vec3 origin(0, 0, 0), u(1, 0, 0), v(0, 1, 0), n(0, 0, 1);
+  const Cloud c = noisyPlane(origin, u, v, 1.0, 0.004, sigma, 11);
+  Eigen::Matrix3d axes;
+  axes << n, v, u;
+  const VoxelMeans columns = columnMeans(c, axes, 0.02, 0.05);
+  const VoxelMeans cubes = voxelMeans(c, 0.02);
+  EXPECT_EQ(columns.cloud.size(), 2500u);
+  EXPECT_LT(rmsOffPlane(columns.cloud.points, origin, n), 0.2 * sigma * 1.1);
+  EXPECT_GT(rmsOffPlane(cubes.cloud.points, origin, n), 0.75 * sigma);
+  // Every sample in one column, each column's count summed back to the cloud.
+  uint32_t total = 0;
+  for (uint32_t k : columns.count) total += k;
+  EXPECT_EQ(total, c.size());
+}
+
+TEST(ColumnMeans, StandsOnAnyPlaneAndKeepsEverySampleOfADeepColumn) {
+  // Two parallel sheets 10 cm apart on a tilted plane, the upper one half as wide:
+  // where they lie over one another a column's samples are 10 cm apart along the
+  // normal, more than the 5 cm allowed, and every one stays a point of its own; the
+  // lower sheet's other half is merged, one point per column.
+  const Vec3 u = Vec3(1, 0, 0.5).normalized(), v = Vec3(0, 1, 0);
+  const Vec3 n = u.cross(v).normalized();
+  const Vec3 origin(2, -3, 1);
+  Cloud c = noisyPlane(origin, u, v, 0.4, 0.005, 0, 3);
+  const size_t lower = c.size();
+  const Cloud upper = noisyPlane(origin + 0.1 * n, u, v, 0.2, 0.005, 0, 4);
+  c.points.insert(c.points.end(), upper.points.begin(), upper.points.end());
+  Eigen::Matrix3d axes;
+  axes << n, v, u;
+  const VoxelMeans m = columnMeans(c, axes, 0.02, 0.05);
+  size_t single = 0;
+  for (size_t i = 0; i < c.size(); ++i) {
+    const uint32_t cell = m.voxel_of[i];
+    // Any point of the upper sheet, and a lower point under it, is its own cell.
+    if (i >= lower) EXPECT_EQ(m.count[cell], 1u) << i;
+    single += m.count[cell] == 1 ? 1 : 0;
+  }
+  // The lower sheet's samples under the upper one (a quarter of them, to within the
+  // columns the upper sheet's edge crosses) are kept too.
+  EXPECT_GE(single, upper.size() + lower / 4 - 400);
+  // The merged columns are the lower sheet's other 300 or so 2 cm squares.
+  const size_t merged = m.cloud.size() - single;
+  EXPECT_GT(merged, 280u);
+  EXPECT_LT(merged, 420u);
+  for (size_t cell = 0; cell < m.cloud.size(); ++cell)
+    if (m.count[cell] > 1) EXPECT_LT(std::abs(n.dot(m.cloud.points[cell] - origin)), 1e-12);
+}
+
+TEST(ColumnMeans, RejectsBadSizesAndAnAttributeOfTheWrongLength) {
+  Cloud c;
+  c.points = {Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  const Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (auto [across, depth] : {std::pair{0.0, 0.05}, {-0.02, 0.05}, {inf, 0.05}, {std::nan(""), 0.05}, {0.02, -0.01},
+                               {0.02, inf}, {0.02, std::nan("")}}) {
+    try {
+      columnMeans(c, axes, across, depth);
+      ADD_FAILURE() << across << ", " << depth << " accepted";
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("[columnMeans] need a column width > 0 and a depth >= 0"), std::string::npos)
+          << e.what();
+    }
+  }
+  c.alpha_rad = {0.1};
+  try {
+    columnMeans(c, axes, 0.02, 0.05);
+    ADD_FAILURE() << "a short alpha was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_STREQ(e.what(), "[columnMeans] an attribute has 1 values for 2 points");
+  }
+}
+
 // The binned selection against a plain sort by (distance², slot), on squared
 // distances spread evenly, crowded into a few values (exact ties across the bin
 // holding the k-th) and beyond the limit.

@@ -368,13 +368,15 @@ TEST(Pipeline, NoisyJibMeetsTheTargetsWithItsTackOnTheSurface) {
 }
 
 TEST(Pipeline, DenseNoisyMainsailKeepsItsEndAnglesWithinTheNoiseTargets) {
-  // Five times denser than above, every point analysed (the default): more points
-  // must not make it worse. The MLS neighbourhood (a fixed count) then spans a smaller
+  // Five times denser than above, every point analysed (working_voxel_sigmas 0): more
+  // points must not make it worse. The MLS neighbourhood (a fixed count) then spans a smaller
   // patch, and an edge point's one-sided quadratic tilts with the noise; on this
   // seed the top section's exit came out 3.8° off when edge fits used k points, not 2k.
   const SailDesign design = exampleDesign(SailType::Main);
   const ScanSimulation sim = scan(200000, 3, 0.004);
-  const SailAnalysis a = analyzeSail(sampleSail(design, sim));
+  AnalysisParams every_point;
+  every_point.working_voxel_sigmas = 0;
+  const SailAnalysis a = analyzeSail(sampleSail(design, sim), every_point);
   EXPECT_EQ(a.working_voxel_m, 0.0);
   EXPECT_EQ(a.working_points, a.sail_points);
   EXPECT_GE(a.mesh.vertices.size(), a.sail_points * 999 / 1000);
@@ -394,7 +396,7 @@ double expectedWorkingVoxel(const Cloud& sail) {
   return std::min(5 * 0.004, box.diagonal().norm() / 500);
 }
 
-// A dense scan goes on at the working resolution: each point the mean of a voxel's
+// A dense scan goes on at the working resolution: each point the mean of a column's
 // samples, a third as many points or fewer, every scan point on the sail still counted.
 void expectWorkingResolution(const SailAnalysis& a, const Cloud& scan) {
   // (The sail's box, and so the voxel, may lose an outlier the scan's box holds.)
@@ -406,14 +408,14 @@ void expectWorkingResolution(const SailAnalysis& a, const Cloud& scan) {
 }
 
 TEST(Pipeline, ADenseNoisyScanIsAnalysedAtTheWorkingResolutionWithinTheNoiseTargets) {
-  // 200,000 samples of a 10 m main and of a jib, 4 mm noise, at the working
-  // resolution: the stages after segmentation work on one mean per voxel of about
-  // 2 cm (3 samples each), and meet the noise targets here.
+  // 200,000 samples of a 10 m main and of a jib, 4 mm noise, with the default
+  // parameters: the stages after segmentation work on one mean per column about 2 cm
+  // wide (4-5 samples each), and meet the noise targets here.
   for (SailType type : {SailType::Main, SailType::Jib}) {
     SCOPED_TRACE(type == SailType::Main ? "main" : "jib");
     const SailDesign design = exampleDesign(type);
     const Cloud cloud = sampleSail(design, scan(200000, 4, 0.004));
-    const SailAnalysis a = analyzeSail(cloud, workingResolution());
+    const SailAnalysis a = analyzeSail(cloud);
     expectWorkingResolution(a, cloud);
     EXPECT_GT(a.working_voxel_m, 0.015);
     expectNoisyTargets(a, design);
@@ -433,8 +435,8 @@ TEST(Pipeline, ADenseCleanModelSailIsMergedNoCoarserThanAFiveHundredthOfItsSize)
 }
 
 TEST(Pipeline, ScansUnderTwoSamplesAVoxelGoOnAtFullResolution) {
-  // 40,000 samples of a 10 m main hold about 1.4 per 2 cm voxel: the mean of one or
-  // two samples is no better a point, so every sample goes on.
+  // 40,000 samples of a 10 m main (18 m²) hold about one per 2 cm column: the mean of
+  // one or two samples is no better a point, so every sample goes on.
   const Cloud cloud = sampleSail(exampleDesign(SailType::Main), scan(40000, 6, 0.004));
   const SailAnalysis a = analyzeSail(cloud, workingResolution());
   EXPECT_EQ(a.working_voxel_m, 0.0);
@@ -943,6 +945,10 @@ TEST(Pipeline, ABadSectionParameterIsReportedBeforeAnyWork) {
   p.working_voxel_sigmas = 5;
   p.working_voxel_of_extent = 0;
   expectThrowWith<InvalidInput>([&] { analyzeSail(wall, p); }, {"[analyzeSail]", "working_voxel_of_extent must be > 0"});
+  p.working_voxel_of_extent = 1.0 / 500;
+  p.working_column_depth_sigmas = -1;
+  expectThrowWith<InvalidInput>([&] { analyzeSail(wall, p); },
+                                {"[analyzeSail]", "working_column_depth_sigmas must be >= 0", "-1"});
 }
 
 TEST(Pipeline, ACleanWindTunnelModelKeepsItsTopSectionWithinTheCleanTargets) {
