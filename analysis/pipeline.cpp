@@ -41,9 +41,13 @@ double workingVoxel(const Cloud& sail, const AnalysisParams& p) {
 }
 
 // The working resolution pays only where the columns hold several samples each: at
-// 40,000 points on a 10 m sail 2 cm columns hold 0.9 on average, and the mean of one
-// or two samples is no better a point than the samples, only fewer of them.
-constexpr double kMinSamplesPerVoxel = 2.0;
+// 40,000 points on a 10 m sail 2 cm columns hold about one on average, and the mean
+// of one or two samples is no better a point than the samples, only fewer of them.
+// Near two a column on average, many hold one and the narrow tips are thinned
+// unevenly: at 100,000-110,000 points (2.05-2.2 a column) one main's head came out
+// 3.4-4.3 cm low where every point put it within 2.1 cm. From three on average,
+// the heads were as close as every point's (bench/independent-sails, 2026-12-02).
+constexpr double kMinSamplesPerColumn = 3.0;
 
 // The readmit parameters with the pipeline's default offset: 0 means 3 sensor σ.
 ReadmitParams readmitParams(const AnalysisParams& p) {
@@ -221,7 +225,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     StageTimer t(a, "working resolution", cloud.size());
     VoxelMeans merged =
         columnMeans(cloud, principalAxes(cloud.points).axes, voxel, p.working_column_depth_sigmas * p.sensor_sigma_m);
-    if (static_cast<double>(merged.cloud.size()) * kMinSamplesPerVoxel <= static_cast<double>(cloud.size())) {
+    if (static_cast<double>(merged.cloud.size()) * kMinSamplesPerColumn <= static_cast<double>(cloud.size())) {
       scan_points = std::move(cloud.points);
       cloud = std::move(merged.cloud);
       represents = std::move(merged.count);

@@ -28,7 +28,7 @@ struct AnalysisParams {
   // neighbourhood size relative to the noise whatever the scanner's density.
   double segmentation_voxel_sigmas = 5.0;
   // The working resolution (0: off, every sample goes on). With working_voxel_sigmas > 0, after
-  // segmentation a scan with two samples or more per column on average goes on as one
+  // segmentation a scan with three samples or more per column on average goes on as one
   // point per occupied column, the mean of its samples (and of their attributes). The
   // columns stand square on the sail's best-fit plane, working_voxel_sigmas sensor σ
   // wide but never wider than working_voxel_of_extent times the sail's bounding-box
