@@ -77,7 +77,7 @@ struct SailAnalysis {
   size_t points_in = 0;
   size_t sail_points = 0;            // scan points on the sail after segmentation and cleaning
   size_t working_points = 0;         // the points the stages after segmentation worked on
-  double working_voxel_m = 0;        // their voxel (0: the scan's own points)
+  double working_voxel_m = 0;        // their columns' width (0: the scan's own points)
   Cloud sail_cloud;                  // the smoothed sail points
   Mesh mesh;
   SailOutline outline;

@@ -32,7 +32,7 @@ void printTable(const SailAnalysis& a) {
   std::printf("Sail: %zu of %zu points, %zu triangles, area %.2f m2\n", a.sail_points, a.points_in,
               a.mesh.triangles.size(), o.area_m2);
   if (a.working_voxel_m > 0)
-    std::printf("  analysed as %zu points, one per %.1f cm voxel\n", a.working_points, 100 * a.working_voxel_m);
+    std::printf("  analysed as %zu points, one per %.1f cm column of the sail (working_voxel_sigmas)\n", a.working_points, 100 * a.working_voxel_m);
   auto corner = [](const char* name, const Vec3& p) {
     std::printf("  %-5s (%8.3f, %8.3f, %8.3f) m\n", name, p.x(), p.y(), p.z());
   };
