@@ -32,7 +32,7 @@ class StageTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
-// The working voxel for the sail's points (analyzeSail's parameters; 0: none).
+// The working resolution's column width for the sail's points (analyzeSail's parameters; 0: none).
 double workingVoxel(const Cloud& sail, const AnalysisParams& p) {
   if (!(p.working_voxel_sigmas > 0) || sail.size() < 2) return 0;
   Eigen::AlignedBox3d box;
@@ -218,7 +218,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
   }
 
   // How many scan points each working point stands for (empty: one each), and the
-  // scan's own sail points when the working points are voxel means.
+  // scan's own sail points when the working points are column means.
   std::vector<uint32_t> represents;
   std::vector<Vec3> scan_points;
   if (const double voxel = workingVoxel(cloud, p); voxel > 0) {
@@ -320,7 +320,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
   }
   {
     StageTimer t(a, "outline", a.mesh.vertices.size());
-    // A voxel mean at a narrow tip lies up to half a voxel short of the tip's outermost
+    // A column mean at a narrow tip lies up to half a column short of the tip's outermost
     // samples: the corners read the scan's own points, at the scan's density.
     double sample_density = 0;
     if (!scan_points.empty()) {

@@ -941,7 +941,7 @@ void App::drawProcessing() {
         case ProcessingStage::Segmentation:
           ImGui::Checkbox("segment (off: the cloud is the sail alone)", &ap.segment);
           inputDouble("voxel (σ)", &ap.segmentation_voxel_sigmas, 1, "%.1f");
-          inputDouble("working voxel (σ)", &ap.working_voxel_sigmas, 1, "%.1f");
+          inputDouble("working column (σ)", &ap.working_voxel_sigmas, 1, "%.1f");
           helpMarker("0 (default): every scan point. Above 0, after segmentation a scan with two samples or "
                      "more per voxel goes on as one point per voxel this many σ wide (never wider than 1/500 "
                      "of the sail): about 3x faster on dense scans, less accurate along the edges");
