@@ -35,6 +35,12 @@ nlohmann::json sectionToJson(const Section& s) {
   return j;
 }
 
+nlohmann::json unmeasuredSectionsToJson(const std::vector<UnmeasuredSection>& unmeasured) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const UnmeasuredSection& u : unmeasured) out.push_back({{"fraction", u.fraction}, {"reason", u.reason}});
+  return out;
+}
+
 nlohmann::json analysisToJson(const SailAnalysis& a) {
   nlohmann::json j;
   const SailOutline& o = a.outline;
@@ -56,10 +62,7 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
   nlohmann::json sections = nlohmann::json::array();
   for (const Section& s : a.sections.sections) sections.push_back(sectionToJson(s));
   j["sections"] = std::move(sections);
-  nlohmann::json unmeasured = nlohmann::json::array();
-  for (const UnmeasuredSection& u : a.sections.unmeasured)
-    unmeasured.push_back({{"fraction", u.fraction}, {"reason", u.reason}});
-  j["unmeasured_sections"] = std::move(unmeasured);
+  j["unmeasured_sections"] = unmeasuredSectionsToJson(a.sections.unmeasured);
   const LuffCurve& l = a.luff;
   j["luff"] = {{"luff_chord_m", l.luff_chord_m},
                {"lufa_sag_m", l.lufa_sag_m},

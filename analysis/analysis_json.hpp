@@ -8,6 +8,8 @@ namespace sailshape {
 
 nlohmann::json sectionParametersToJson(const SectionParameters& p);
 nlohmann::json sectionToJson(const Section& s);
+// The sections asked for but not measured: [{fraction, reason}, ...].
+nlohmann::json unmeasuredSectionsToJson(const std::vector<UnmeasuredSection>& unmeasured);
 nlohmann::json analysisToJson(const SailAnalysis& analysis);
 
 }  // namespace sailshape

@@ -274,10 +274,10 @@ struct Frontier {
   double mean_gap = 0;                // m
 };
 
-Frontier frontierRecess(std::vector<std::pair<double, double>> along_offset, double D, double window) {
+// `along_offset` as forEachWindow takes it: ascending in arc position.
+Frontier frontierRecess(const std::vector<std::pair<double, double>>& along_offset, double D, double window) {
   Frontier f;
   if (!(window > 0)) return f;  // no spacing to step by
-  std::sort(along_offset.begin(), along_offset.end());
   struct Window {
     double centre, span, least;
     size_t n;
@@ -366,10 +366,10 @@ struct GapShape {
   double ratio() const { return mean_gap > 0 ? residual / mean_gap : 0; }
 };
 
-GapShape gapShape(std::vector<std::pair<double, double>> along_offset, double window) {
+// `along_offset` ascending in arc position, as for frontierRecess.
+GapShape gapShape(const std::vector<std::pair<double, double>>& along_offset, double window) {
   GapShape g;
   if (!(window > 0)) return g;
-  std::sort(along_offset.begin(), along_offset.end());
   double sum = 0, sum2 = 0, gaps = 0;
   std::vector<double> o;
   forEachWindow(along_offset, window, [&](size_t a, size_t b) {
@@ -406,8 +406,8 @@ bool onScanLines(const GapShape& g) { return g.gaps > 0 && g.ratio() > 1.5 + 30.
 // lines cross an edge, each line ends on it, so the envelope touches the line ends
 // and is the edge; a fit through the outermost samples would follow the staircase
 // the last line leaves between crossings. nullopt when the programme has no optimum.
-std::optional<Polynomial> lowerEnvelope(std::vector<std::pair<double, double>> along_offset, double window, int degree) {
-  std::sort(along_offset.begin(), along_offset.end());
+// `along_offset` ascending in arc position, as for frontierRecess.
+std::optional<Polynomial> lowerEnvelope(const std::vector<std::pair<double, double>>& along_offset, double window, int degree) {
   std::vector<double> s, least;
   forEachWindow(along_offset, window, [&](size_t a, size_t b) {
     size_t at = a;
@@ -523,6 +523,7 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
   // millimetre there): estimates from those are several times sharper. They
   // also hold after smoothing, which pulls a noisy scan's outermost samples in
   // less than the samples behind them (the mean came out 3-6 mm short there).
+  std::sort(along_offset.begin(), along_offset.end());  // for the windows along the edge
   const Frontier frontier = count >= 30 ? frontierRecess(along_offset, strip, kFrontierWindowSpacings * spacing) : Frontier{};
   // The frontier model below is a scatter's; on scan lines it places the edge by the
   // last line, up to a line spacing inside (extractOutline says so and widens σ).
@@ -592,6 +593,7 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
         if (o <= strip && o >= -2.0 * e.line_spacing) beside.emplace_back(e.s[i] + d.dot(t), o);
       }
     }
+    std::sort(beside.begin(), beside.end());
     const std::optional<Polynomial> envelope = lowerEnvelope(beside, spacing, degree);
     // It lies within a line spacing and a half beyond the curve through the boundary
     // and no more than half a spacing inside it; further off, the boundary is not the

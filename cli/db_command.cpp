@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 
+#include "analysis/analysis_json.hpp"
 #include "analysis/cloud_io.hpp"
 #include "analysis/errors.hpp"
 #include "cli/commands.hpp"
@@ -287,9 +288,7 @@ void addDbCommand(CLI::App& app) {
     if (o->json) {
       nlohmann::ordered_json j = tableToJson(scan)[0];
       j["sections"] = tableToJson(sections);
-      j["unmeasured_sections"] = nlohmann::ordered_json::array();
-      for (const UnmeasuredSection& u : unmeasured)
-        j["unmeasured_sections"].push_back({{"fraction", u.fraction}, {"reason", u.reason}});
+      j["unmeasured_sections"] = unmeasuredSectionsToJson(unmeasured);
       std::cout << j.dump(2) << "\n";
       return;
     }
