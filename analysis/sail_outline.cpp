@@ -486,30 +486,37 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
 
 
   const double strip = kFrontierStripSpacings * spacing;
-  double sum = 0;
-  size_t count = 0;
-  std::vector<char> seen(mesh.vertices.size(), 0);
-  std::vector<std::pair<double, double>> along_offset;  // (arc position, offset o) of each sample in the strip
-  for (size_t k = 0; k < inner.size(); k += 2) {
-    const size_t i = inner[k];
-    const Vec3 c = e.curve.at(e.s[i]);
-    const Vec3 t = e.curve.tangent(e.s[i]);
-    // The disc must hold the whole window |along| <= spacing, 0 <= o <= strip: a disc
-    // of radius `strip` alone cuts its far corners, thins the samples near o = strip
-    // and so overstates the recess (by about 0.08 × spacing).
-    tree.withinRadius(c, std::hypot(strip, spacing), idx, d2);
-    for (uint32_t v : idx) {
-      if (seen[v]) continue;
-      const Vec3 d = mesh.vertices[v] - c;
-      if (std::abs(d.dot(t)) > spacing) continue;  // belongs to a neighbouring sample
-      seen[v] = 1;
-      const double o = d.dot(inward[i]);
-      if (o > strip) continue;
-      sum += o;
-      ++count;
-      along_offset.emplace_back(e.s[i] + d.dot(t), o);
+  // The samples in the strip beside the edge, as (arc position, offset o) with
+  // lowest <= o <= strip: round the points `at` of the edge, each within a spacing
+  // along it of `centre(i)` (tangent `tangent(i)`), offsets along inward[i]. The
+  // disc searched must hold the whole window |along| <= spacing, 0 <= o <= strip: a
+  // disc of radius `strip` alone cuts its far corners, thins the samples near
+  // o = strip and so overstates the recess (by about 0.08 × spacing).
+  auto stripSamples = [&](const std::vector<size_t>& at, auto centre, auto tangent, double lowest) {
+    std::vector<std::pair<double, double>> out;
+    std::vector<char> seen(mesh.vertices.size(), 0);
+    for (size_t i : at) {
+      const Vec3 c = centre(i), t = tangent(i);
+      tree.withinRadius(c, std::hypot(strip, spacing), idx, d2);
+      for (uint32_t v : idx) {
+        if (seen[v]) continue;
+        const Vec3 d = mesh.vertices[v] - c;
+        if (std::abs(d.dot(t)) > spacing) continue;  // belongs to a neighbouring point
+        seen[v] = 1;
+        const double o = d.dot(inward[i]);
+        if (o <= strip && o >= lowest) out.emplace_back(e.s[i] + d.dot(t), o);
+      }
     }
-  }
+    return out;
+  };
+  std::vector<size_t> every_other;
+  for (size_t k = 0; k < inner.size(); k += 2) every_other.push_back(inner[k]);
+  std::vector<std::pair<double, double>> along_offset = stripSamples(
+      every_other, [&](size_t i) { return e.curve.at(e.s[i]); }, [&](size_t i) { return e.curve.tangent(e.s[i]); },
+      -std::numeric_limits<double>::infinity());
+  double sum = 0;
+  for (const auto& [along, o] : along_offset) sum += o;
+  const size_t count = along_offset.size();
   // δ's σ: offsets spread over about the strip width, uniform.
   double sigma_recess = strip / std::sqrt(3.0);
   if (count >= 30) {
@@ -577,22 +584,13 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
     };
     Vec3 inward_mean = Vec3::Zero();
     for (size_t i : inner) inward_mean += inward[i];
-    std::vector<std::pair<double, double>> beside;
-    std::fill(seen.begin(), seen.end(), 0);
-    for (size_t i = 0; i < e.points.size(); i += 2) {
-      if (inward[i].dot(inward_mean) <= 0) continue;
-      const Vec3 c = reference(e.s[i]), t = e.curve.tangent(std::clamp(e.s[i], e.exclude, e.length - e.exclude));
-      tree.withinRadius(c, std::hypot(strip, spacing), idx, d2);
-      for (uint32_t v : idx) {
-        if (seen[v]) continue;
-        const Vec3 d = mesh.vertices[v] - c;
-        if (std::abs(d.dot(t)) > spacing) continue;
-        seen[v] = 1;
-        const double o = d.dot(inward[i]);
-        // Two line spacings beyond the curve is a stray, not a line's end.
-        if (o <= strip && o >= -2.0 * e.line_spacing) beside.emplace_back(e.s[i] + d.dot(t), o);
-      }
-    }
+    std::vector<size_t> facing;
+    for (size_t i = 0; i < e.points.size(); i += 2)
+      if (inward[i].dot(inward_mean) > 0) facing.push_back(i);
+    // Two line spacings beyond the curve is a stray, not a line's end.
+    std::vector<std::pair<double, double>> beside = stripSamples(
+        facing, [&](size_t i) { return reference(e.s[i]); }, [&](size_t i) { return e.curve.tangent(std::clamp(e.s[i], e.exclude, e.length - e.exclude)); },
+        -2.0 * e.line_spacing);
     std::sort(beside.begin(), beside.end());
     const std::optional<Polynomial> envelope = lowerEnvelope(beside, spacing, degree);
     // It lies within a line spacing and a half beyond the curve through the boundary
