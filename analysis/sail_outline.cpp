@@ -587,10 +587,12 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
     std::vector<size_t> facing;
     for (size_t i = 0; i < e.points.size(); i += 2)
       if (inward[i].dot(inward_mean) > 0) facing.push_back(i);
+    auto reference_tangent = [&](size_t i) {
+      return e.curve.tangent(std::clamp(e.s[i], e.exclude, e.length - e.exclude));
+    };
     // Two line spacings beyond the curve is a stray, not a line's end.
     std::vector<std::pair<double, double>> beside = stripSamples(
-        facing, [&](size_t i) { return reference(e.s[i]); }, [&](size_t i) { return e.curve.tangent(std::clamp(e.s[i], e.exclude, e.length - e.exclude)); },
-        -2.0 * e.line_spacing);
+        facing, [&](size_t i) { return reference(e.s[i]); }, reference_tangent, -2.0 * e.line_spacing);
     std::sort(beside.begin(), beside.end());
     const std::optional<Polynomial> envelope = lowerEnvelope(beside, spacing, degree);
     // It lies within a line spacing and a half beyond the curve through the boundary
