@@ -10,15 +10,20 @@ namespace sailshape {
 namespace {
 
 constexpr uint32_t kLeafTriangles = 4;
+constexpr int kSahDepth = 40;  // the traversal stack holds 64 levels
 
-// Slab test; inv holds 1/direction (±inf for zero components).
-bool hitsBox(const Vec3& lo, const Vec3& hi, const Vec3& o, const Vec3& inv, double t_max, double& t_enter) {
+// Slab test; inv holds 1/direction (±inf for zero components, where `parallel` is set and 0 · inf on a
+// slab face needs care). t_enter is where the ray enters the box (0 when it starts inside).
+bool hitsBox(const Vec3& lo, const Vec3& hi, const Vec3& o, const Vec3& inv, bool parallel, double t_max,
+             double& t_enter) {
   double t0 = 0, t1 = t_max;
   for (int k = 0; k < 3; ++k) {
     double a = (lo[k] - o[k]) * inv[k], b = (hi[k] - o[k]) * inv[k];
     if (a > b) std::swap(a, b);
-    if (std::isnan(a)) a = -std::numeric_limits<double>::infinity();  // 0 · inf on a slab face
-    if (std::isnan(b)) b = std::numeric_limits<double>::infinity();
+    if (parallel) {
+      if (std::isnan(a)) a = -std::numeric_limits<double>::infinity();
+      if (std::isnan(b)) b = std::numeric_limits<double>::infinity();
+    }
     t0 = std::max(t0, a);
     t1 = std::min(t1, b);
     if (t0 > t1) return false;
@@ -48,10 +53,10 @@ RayCaster::RayCaster(const Scene& scene) {
   std::vector<Vec3> centroids(tris_.size());
   for (size_t i = 0; i < tris_.size(); ++i) centroids[i] = tris_[i].a + (tris_[i].e1 + tris_[i].e2) / 3.0;
   nodes_.reserve(2 * tris_.size() / kLeafTriangles + 1);
-  build(0, static_cast<uint32_t>(tris_.size()), centroids);
+  build(0, static_cast<uint32_t>(tris_.size()), centroids, 0);
 }
 
-uint32_t RayCaster::build(uint32_t first, uint32_t count, std::vector<Vec3>& centroids) {
+uint32_t RayCaster::build(uint32_t first, uint32_t count, std::vector<Vec3>& centroids, int depth) {
   const auto index = static_cast<uint32_t>(nodes_.size());
   nodes_.push_back(Node{Vec3::Zero(), Vec3::Zero(), 0, 0});
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -74,12 +79,72 @@ uint32_t RayCaster::build(uint32_t first, uint32_t count, std::vector<Vec3>& cen
     nodes_[index].count = count;
     return index;
   }
-  // Median split by centroid: sort the triangle range and its centroids together.
-  const uint32_t mid = first + count / 2;
   std::vector<uint32_t> order(count);
   for (uint32_t i = 0; i < count; ++i) order[i] = first + i;
-  std::nth_element(order.begin(), order.begin() + (mid - first), order.end(),
-                   [&](uint32_t a, uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
+  uint32_t mid = first + count / 2;
+  // The split a ray pays least for (surface-area heuristic over binned centroids): a wall's few large
+  // triangles and a sail's many small ones end up in boxes of their own instead of one box spanning both.
+  // Past kSahDepth, or with no split found, the median on the longest centroid axis keeps the depth bounded.
+  int best_axis = -1, best_bin = 0;
+  if (depth < kSahDepth) {
+    constexpr int kBins = 16;
+    const auto area = [](const Vec3& a, const Vec3& b) {
+      const Vec3 e = (b - a).cwiseMax(0.0);
+      return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    };
+    double best_cost = area(lo, hi) * count;  // as a leaf of all of them (what a split must beat)
+    for (int k = 0; k < 3; ++k) {
+      const double ext = chi[k] - clo[k];
+      if (!(ext > 0)) continue;
+      Vec3 blo[kBins], bhi[kBins];
+      uint32_t bn[kBins] = {};
+      for (int b = 0; b < kBins; ++b) blo[b] = Vec3::Constant(std::numeric_limits<double>::infinity()), bhi[b] = -blo[b];
+      for (uint32_t i = first; i < first + count; ++i) {
+        const int b = std::min(kBins - 1, static_cast<int>((centroids[i][k] - clo[k]) / ext * kBins));
+        const Triangle& t = tris_[i];
+        for (const Vec3& p : {t.a, Vec3(t.a + t.e1), Vec3(t.a + t.e2)}) {
+          blo[b] = blo[b].cwiseMin(p);
+          bhi[b] = bhi[b].cwiseMax(p);
+        }
+        ++bn[b];
+      }
+      double right_cost[kBins] = {};
+      Vec3 rlo = Vec3::Constant(std::numeric_limits<double>::infinity()), rhi = -rlo;
+      uint32_t rn = 0;
+      for (int b = kBins - 1; b > 0; --b) {
+        rlo = rlo.cwiseMin(blo[b]);
+        rhi = rhi.cwiseMax(bhi[b]);
+        rn += bn[b];
+        right_cost[b] = rn > 0 ? area(rlo, rhi) * rn : 0;
+      }
+      Vec3 llo = Vec3::Constant(std::numeric_limits<double>::infinity()), lhi = -llo;
+      uint32_t ln = 0;
+      for (int b = 0; b < kBins - 1; ++b) {
+        llo = llo.cwiseMin(blo[b]);
+        lhi = lhi.cwiseMax(bhi[b]);
+        ln += bn[b];
+        if (ln == 0 || ln == count) continue;
+        const double cost = area(llo, lhi) * ln + right_cost[b + 1];
+        if (cost < best_cost) {
+          best_cost = cost;
+          best_axis = k;
+          best_bin = b;
+        }
+      }
+    }
+  }
+  if (best_axis >= 0) {
+    const int k = best_axis;
+    const double ext = chi[k] - clo[k];
+    const auto split = std::partition(order.begin(), order.end(), [&](uint32_t i) {
+      return std::min(15, static_cast<int>((centroids[i][k] - clo[k]) / ext * 16)) <= best_bin;
+    });
+    mid = first + static_cast<uint32_t>(split - order.begin());
+  } else {
+    std::nth_element(order.begin(), order.begin() + (mid - first), order.end(),
+                     [&](uint32_t a, uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
+  }
+  // Reorder the triangle range and its centroids together.
   std::vector<Triangle> tris(count);
   std::vector<Vec3> cents(count);
   for (uint32_t i = 0; i < count; ++i) {
@@ -88,11 +153,41 @@ uint32_t RayCaster::build(uint32_t first, uint32_t count, std::vector<Vec3>& cen
   }
   std::copy(tris.begin(), tris.end(), tris_.begin() + first);
   std::copy(cents.begin(), cents.end(), centroids.begin() + first);
-  build(first, mid - first, centroids);
-  const uint32_t right = build(mid, first + count - mid, centroids);
+  build(first, mid - first, centroids, depth + 1);
+  const uint32_t right = build(mid, first + count - mid, centroids, depth + 1);
   nodes_[index].first = right;
   nodes_[index].count = 0;
   return index;
+}
+
+// Möller–Trumbore: the distance along unit d at which the ray meets the triangle, when nearer than t_best.
+inline bool RayCaster::meets(const Triangle& t, const Vec3& origin, const Vec3& d, double min_m, double t_best,
+                             double& dist) {
+  const Vec3 pv = d.cross(t.e2);
+  const double det = t.e1.dot(pv);
+  if (std::abs(det) < 1e-14) return false;
+  const double inv_det = 1.0 / det;
+  const Vec3 tv = origin - t.a;
+  const double u = tv.dot(pv) * inv_det;
+  if (u < 0 || u > 1) return false;
+  const Vec3 qv = tv.cross(t.e1);
+  const double v = d.dot(qv) * inv_det;
+  if (v < 0 || u + v > 1) return false;
+  dist = t.e2.dot(qv) * inv_det;
+  return dist > min_m && dist < t_best;
+}
+
+RayHit RayCaster::hitOf(const Triangle* t, double distance_m, const Vec3& d) {
+  RayHit best;
+  if (!t) return best;
+  best.hit = true;
+  best.distance_m = distance_m;
+  best.object = t->object;
+  best.triangle = t->index;
+  Vec3 nrm = t->e1.cross(t->e2).normalized();
+  if (nrm.dot(d) > 0) nrm = -nrm;
+  best.normal = nrm;
+  return best;
 }
 
 RayHit RayCaster::cast(const Vec3& origin, const Vec3& direction, double min_m, double max_m) const {
@@ -101,32 +196,30 @@ RayHit RayCaster::cast(const Vec3& origin, const Vec3& direction, double min_m, 
   if (!(len > 0) || !origin.allFinite()) return best;
   const Vec3 d = direction / len;
   const Vec3 inv(1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z());
+  const bool parallel = !inv.allFinite();  // a zero (or denormal) direction component
   double t_best = max_m;
   const Triangle* hit = nullptr;
-  uint32_t stack[64];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& n = nodes_[stack[--top]];
+  // Nodes still to visit with where the ray enters them: a node entered beyond the nearest hit found
+  // since it was pushed holds nothing nearer, so its box need not be tested again.
+  struct Pending {
+    uint32_t node;
     double t_enter;
-    if (!hitsBox(n.lo, n.hi, origin, inv, t_best, t_enter)) continue;
+  };
+  Pending stack[64];
+  int top = 0;
+  double t_root = 0;
+  if (!hitsBox(nodes_[0].lo, nodes_[0].hi, origin, inv, parallel, t_best, t_root)) return best;
+  stack[top++] = {0, t_root};
+  while (top > 0) {
+    const Pending next = stack[--top];
+    if (next.t_enter > t_best) continue;
+    const Node& n = nodes_[next.node];
     if (n.count > 0) {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-        const Triangle& t = tris_[i];
-        const Vec3 pv = d.cross(t.e2);
-        const double det = t.e1.dot(pv);
-        if (std::abs(det) < 1e-14) continue;
-        const double inv_det = 1.0 / det;
-        const Vec3 tv = origin - t.a;
-        const double u = tv.dot(pv) * inv_det;
-        if (u < 0 || u > 1) continue;
-        const Vec3 qv = tv.cross(t.e1);
-        const double v = d.dot(qv) * inv_det;
-        if (v < 0 || u + v > 1) continue;
-        const double dist = t.e2.dot(qv) * inv_det;
-        if (dist > min_m && dist < t_best) {
+        double dist;
+        if (meets(tris_[i], origin, d, min_m, t_best, dist)) {
           t_best = dist;
-          hit = &t;
+          hit = &tris_[i];
         }
       }
       continue;
@@ -134,28 +227,103 @@ RayHit RayCaster::cast(const Vec3& origin, const Vec3& direction, double min_m, 
     // Visit the nearer child first (pushed last).
     const uint32_t left = static_cast<uint32_t>(&n - nodes_.data()) + 1, right = n.first;
     double tl = 0, tr = 0;
-    const bool hl = hitsBox(nodes_[left].lo, nodes_[left].hi, origin, inv, t_best, tl);
-    const bool hr = hitsBox(nodes_[right].lo, nodes_[right].hi, origin, inv, t_best, tr);
+    const bool hl = hitsBox(nodes_[left].lo, nodes_[left].hi, origin, inv, parallel, t_best, tl);
+    const bool hr = hitsBox(nodes_[right].lo, nodes_[right].hi, origin, inv, parallel, t_best, tr);
     if (top + 2 > 64) throw AnalysisError("[RayCaster::cast] hierarchy deeper than 64 levels");
     if (hl && hr) {
-      stack[top++] = tl < tr ? right : left;
-      stack[top++] = tl < tr ? left : right;
+      if (tl < tr) {
+        stack[top++] = {right, tr};
+        stack[top++] = {left, tl};
+      } else {
+        stack[top++] = {left, tl};
+        stack[top++] = {right, tr};
+      }
     } else if (hl) {
-      stack[top++] = left;
+      stack[top++] = {left, tl};
     } else if (hr) {
-      stack[top++] = right;
+      stack[top++] = {right, tr};
     }
   }
-  if (hit) {
-    best.hit = true;
-    best.distance_m = t_best;
-    best.object = hit->object;
-    best.triangle = hit->index;
-    Vec3 nrm = hit->e1.cross(hit->e2).normalized();
-    if (nrm.dot(d) > 0) nrm = -nrm;
-    best.normal = nrm;
+  return hitOf(hit, t_best, d);
+}
+
+void RayCaster::castBundle(const Vec3* origins, const Vec3* directions, size_t count, RayHit* out,
+                           double min_m) const {
+  if (count > kMaxBundle) throw InvalidInput("[RayCaster::castBundle] at most " + std::to_string(kMaxBundle) +
+                                             " rays share a traversal (got " + std::to_string(count) + ")");
+  Vec3 d[kMaxBundle], inv[kMaxBundle];
+  bool parallel[kMaxBundle];
+  double t_best[kMaxBundle];
+  const Triangle* hit[kMaxBundle];
+  uint32_t live = 0;  // rays that can hit anything
+  for (size_t r = 0; r < count; ++r) {
+    out[r] = RayHit{};
+    hit[r] = nullptr;
+    t_best[r] = std::numeric_limits<double>::infinity();
+    const double len = directions[r].norm();
+    if (!(len > 0) || !origins[r].allFinite()) continue;
+    d[r] = directions[r] / len;
+    inv[r] = Vec3(1.0 / d[r].x(), 1.0 / d[r].y(), 1.0 / d[r].z());
+    parallel[r] = !inv[r].allFinite();
+    live |= 1u << r;
   }
-  return best;
+  // As in cast(), with a mask of the rays that entered each pending node and where each entered it.
+  struct Pending {
+    uint32_t node, rays;
+    double t_enter[kMaxBundle];
+  };
+  Pending stack[64];
+  int top = 0;
+  const auto test = [&](uint32_t node, uint32_t rays, Pending& p) {
+    p.node = node;
+    p.rays = 0;
+    for (uint32_t r = 0; r < count; ++r)
+      if ((rays >> r & 1u) &&
+          hitsBox(nodes_[node].lo, nodes_[node].hi, origins[r], inv[r], parallel[r], t_best[r], p.t_enter[r]))
+        p.rays |= 1u << r;
+    return p.rays != 0;
+  };
+  if (live == 0 || !test(0, live, stack[0])) return;
+  top = 1;
+  while (top > 0) {
+    Pending next = stack[--top];
+    for (uint32_t r = 0; r < count; ++r)
+      if ((next.rays >> r & 1u) && next.t_enter[r] > t_best[r]) next.rays &= ~(1u << r);
+    if (next.rays == 0) continue;
+    const Node& n = nodes_[next.node];
+    if (n.count > 0) {
+      for (uint32_t i = n.first; i < n.first + n.count; ++i)
+        for (uint32_t r = 0; r < count; ++r) {
+          double dist;
+          if ((next.rays >> r & 1u) && meets(tris_[i], origins[r], d[r], min_m, t_best[r], dist)) {
+            t_best[r] = dist;
+            hit[r] = &tris_[i];
+          }
+        }
+      continue;
+    }
+    if (top + 2 > 64) throw AnalysisError("[RayCaster::castBundle] hierarchy deeper than 64 levels");
+    const uint32_t left = static_cast<uint32_t>(&n - nodes_.data()) + 1, right = n.first;
+    Pending l, rt;
+    const bool hl = test(left, next.rays, l), hr = test(right, next.rays, rt);
+    // The nearer child first (pushed last), as the first ray that entered both sees them.
+    bool left_first = true;
+    if (hl && hr)
+      for (uint32_t r = 0; r < count; ++r)
+        if (l.rays & rt.rays & (1u << r)) {
+          left_first = l.t_enter[r] < rt.t_enter[r];
+          break;
+        }
+    if (hl && hr) {
+      stack[top++] = left_first ? rt : l;
+      stack[top++] = left_first ? l : rt;
+    } else if (hl) {
+      stack[top++] = l;
+    } else if (hr) {
+      stack[top++] = rt;
+    }
+  }
+  for (size_t r = 0; r < count; ++r) out[r] = hitOf(hit[r], t_best[r], d[r]);
 }
 
 }  // namespace sailshape

@@ -1,6 +1,6 @@
 #pragma once
 // Ray–triangle casting against a Scene through a bounding-volume hierarchy
-// (median split on the longest centroid axis, Möller–Trumbore per triangle).
+// (binned surface-area-heuristic splits, Möller–Trumbore per triangle).
 // A sweep is hundreds of scan lines × ~1000 beams × a few footprint rays, so
 // each query is O(log n) and allocation-free; queries are const and thread-safe.
 #include <array>
@@ -29,6 +29,13 @@ class RayCaster {
   RayHit cast(const Vec3& origin, const Vec3& direction, double min_m = 1e-6,
               double max_m = std::numeric_limits<double>::infinity()) const;
 
+  // The nearest hits of `count` (≤ kMaxBundle) rays at once, out[i] as cast(origins[i], directions[i])
+  // gives it, in one traversal of the hierarchy: for a beam's footprint, rays that stay close together,
+  // this visits each node once instead of once per ray.
+  static constexpr size_t kMaxBundle = 8;
+  void castBundle(const Vec3* origins, const Vec3* directions, size_t count, RayHit* out,
+                  double min_m = 1e-6) const;
+
   size_t triangleCount() const { return tris_.size(); }
   size_t nodeCount() const { return nodes_.size(); }
 
@@ -42,7 +49,9 @@ class RayCaster {
     uint32_t first;  // leaf: first triangle; inner: index of the right child (left child = this + 1)
     uint32_t count;  // > 0 for a leaf
   };
-  uint32_t build(uint32_t first, uint32_t count, std::vector<Vec3>& centroids);
+  uint32_t build(uint32_t first, uint32_t count, std::vector<Vec3>& centroids, int depth);
+  static bool meets(const Triangle& t, const Vec3& origin, const Vec3& d, double min_m, double t_best, double& dist);
+  static RayHit hitOf(const Triangle* t, double distance_m, const Vec3& d);
 
   std::vector<Triangle> tris_;
   std::vector<Node> nodes_;

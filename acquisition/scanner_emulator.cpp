@@ -184,8 +184,17 @@ void ScannerEmulator::runSession(int fd) {
     }
     // Due as the stream now stands: a request just read may have started it (or the spin-up holds it).
     if (s.streaming && s.measuring && Clock::now() >= scanTime(s.next_scan + 1)) {
+      // Behind by more than max_lag_s: the scans in between are lost, counted but never sent.
+      const Clock::time_point now = Clock::now();
+      const auto max_lag = std::chrono::microseconds(roundToInt(std::max(0.0, params_.max_lag_s) * 1e6));
+      while (now - scanTime(s.next_scan + 1) > max_lag) {
+        ++s.next_scan;
+        ++s.scan_counter;
+        ++scans_dropped_;
+      }
       const Clock::time_point scan_start = scanTime(s.next_scan);
       ++s.next_scan;
+      if (params_.slow_host_s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(params_.slow_host_s));
       if (!sendAll(frameCola(binary ? ColaDialect::kBinary : ColaDialect::kAscii,
                              scanPayload(binary, false, scan_start))))
         return;

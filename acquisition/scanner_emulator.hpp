@@ -32,10 +32,15 @@ struct ScannerEmulatorParams {
   // Seconds after power-on (the emulator's construction) during which the device is still starting: it
   // answers SCdevicestate 0 (busy), as the recorded units did, and streams no scan before then.
   double spin_up_s = 0.0;
+  // A device measures in real time and never falls behind. An emulator whose host cannot ray-cast its
+  // scans at the configured rate (a slow or sanitised build) would: it drops the scans it is more than
+  // this late for, as a device drops what its output cannot send, and its scan counter still counts them.
+  double max_lag_s = 0.25;
   // Faults, for the client's tests.
   bool refuse_login = false;               // SetAccessMode answers 0
   bool mute = false;                       // accepts and reads, never answers
   int drop_after_scans = -1;               // closes the connection after this many streamed scans (≥ 0)
+  double slow_host_s = 0.0;                // each streamed scan takes at least this long to compute (a slow host)
 };
 
 class ScannerEmulator {
@@ -49,6 +54,8 @@ class ScannerEmulator {
 
   uint16_t port() const { return port_; }
   uint64_t scansSent() const { return scans_sent_; }
+  // Scans dropped because the host could not compute them in time (see ScannerEmulatorParams::max_lag_s).
+  uint64_t scansDropped() const { return scans_dropped_; }
   uint64_t connections() const { return connections_; }
 
   // The reply payloads (unframed) to one request payload in `binary` or ASCII; what a connection gets.
@@ -70,7 +77,7 @@ class ScannerEmulator {
   int listen_fd_ = -1;
   uint16_t port_ = 0;
   std::atomic<bool> stop_{false};
-  std::atomic<uint64_t> scans_sent_{0}, connections_{0};
+  std::atomic<uint64_t> scans_sent_{0}, scans_dropped_{0}, connections_{0};
   std::thread thread_;
   std::unique_ptr<Session> session_;  // state of the current connection (serve thread only)
 };

@@ -70,9 +70,19 @@ EmulatedSensor::EmulatedSensor(const Scene& scene, const SensorModelParams& para
 BeamReturn EmulatedSensor::measure(const Vec3& origin, const Vec3& direction, std::mt19937_64& rng) const {
   BeamReturn out;
   const Vec3 d = direction.normalized();
-  // Footprint: the axis ray plus four rays on the rim of the beam (exit radius
-  // at the window, half the divergence beyond), weights 2:1:1:1:1.
-  const RayHit axis = caster_.cast(origin, d);
+  // Footprint: the axis ray plus four rays on the rim of the beam (exit radius at the window, half the
+  // divergence beyond), weights 2:1:1:1:1, cast together (they share one traversal of the scene).
+  const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
+  const double half = 0.5 * spec_.beam_divergence_rad, rim = 0.5 * spec_.exit_diameter_m;
+  const Vec3 rim_dirs[4] = {u, Vec3(-u), v, Vec3(-v)};
+  Vec3 origins[5] = {origin}, dirs[5] = {d};
+  for (int k = 0; k < 4; ++k) {
+    origins[k + 1] = origin + rim * rim_dirs[k];
+    dirs[k + 1] = d + half * rim_dirs[k];
+  }
+  RayHit hits[5];
+  caster_.castBundle(origins, dirs, params_.mixed_pixels ? 5 : 1, hits);
+  const RayHit& axis = hits[0];
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   std::normal_distribution<double> gauss(0.0, 1.0);
   if (!axis.hit) return out;
@@ -84,14 +94,13 @@ BeamReturn EmulatedSensor::measure(const Vec3& origin, const Vec3& direction, st
   double range = axis.distance_m;
   double weight = 2.0;
   if (params_.mixed_pixels) {
-    const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
-    const double half = 0.5 * spec_.beam_divergence_rad, rim = 0.5 * spec_.exit_diameter_m;
     const double spread_allowed =
         params_.mixed_pixel_depth_m + axis.distance_m * half * std::tan(std::min(out.incidence_deg, 85.0) * kDeg);
     double sum = 2.0 * axis.distance_m;
     bool straddles = false;
-    for (const Vec3& w : {u, Vec3(-u), v, Vec3(-v)}) {
-      const RayHit h = caster_.cast(origin + rim * w, d + half * w);
+    for (int k = 0; k < 4; ++k) {
+      const RayHit& h = hits[k + 1];
+      const Vec3& w = rim_dirs[k];
       if (!h.hit) {
         straddles = true;
         continue;

@@ -158,6 +158,9 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
                             unit.speed_deg_s / unit.acceleration_deg_s2 + 2.0;
   double last_poll = 0;
   double idle_at = -1;
+  // The scanner's clock on the host's, as the smallest receive − transmission gap so far: a scan that
+  // arrives late (a busy network, or a device draining its output) is still placed at its own time.
+  double running_offset = std::numeric_limits<double>::infinity();
   for (;;) {
     const double now = hostTimeSeconds();
     if (now - last_poll > 0.015 || idle_at < 0) {
@@ -174,7 +177,9 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
       progress("sweep", std::clamp((countsToDeg(st.counts) - unit.start_angle_deg) / unit.sweep_angle_deg, 0.0, 1.0));
     }
     // One more scan after the table stopped so the last moving scan has a successor for β interpolation.
-    if (idle_at > 0 && !scans.empty() && scans.back().host_time_s > idle_at + 1.5 / unit.frequency_hz) break;
+    if (idle_at > 0 && !scans.empty() &&
+        scans.back().data.time_since_startup_us * 1e-6 + running_offset > idle_at + 0.5 / unit.frequency_hz)
+      break;
     if (now - sweep.start_time_s > expected_s + options.scan_timeout_s) {
       sweep.partial = true;
       sweep.message = "the turntable did not finish the sweep within " + std::to_string(expected_s) + " s";
@@ -184,6 +189,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
       ScanData s = scanner.nextScan();
       if (options.on_scan) options.on_scan(previewPoints(unit, s, table_samples.back().deg));
       scans.push_back({std::move(s), hostTimeSeconds()});
+      running_offset = std::min(running_offset, scans.back().host_time_s - scans.back().data.time_of_transmission_us * 1e-6);
     } catch (const ScannerError& e) {
       sweep.partial = true;
       sweep.message = e.what();
@@ -212,6 +218,12 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     clock_offset = std::min(clock_offset, r.host_time_s - r.data.time_of_transmission_us * 1e-6);
   const bool encoder = unit.beta_source == BetaSource::Encoder;
   size_t used = 0;
+  // Scans the device counted but never delivered: gaps in the scan counter between received scans.
+  for (size_t k = 1; k < scans.size(); ++k) {
+    const uint16_t step = static_cast<uint16_t>(scans[k].data.scan_counter - scans[k - 1].data.scan_counter);
+    if (step > 1 && scans[k].data.time_since_startup_us * 1e-6 + clock_offset >= sweep.start_time_s)
+      sweep.scans_missed += step - 1u;
+  }
   for (size_t k = 0; k < scans.size(); ++k) {
     const ScanData& s = scans[k].data;
     const ScanChannel* dist = s.channel("DIST1");
@@ -269,6 +281,10 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     }
   }
   sweep.scans = used;
+  if (sweep.scans_missed > 0)
+    sweep.warnings.push_back(std::to_string(sweep.scans_missed) + " of " + std::to_string(used + sweep.scans_missed) +
+                             " scans of the sweep never arrived (gaps in the scan counter): the scan lines are "
+                             "that much further apart there");
   if (!sweep.points.empty()) {
     sweep.beta_start_deg = sweep.points.front().beta_rad / kDeg;
     sweep.beta_end_deg = sweep.points.back().beta_rad / kDeg;

@@ -51,6 +51,7 @@ struct Sweep {
   Cloud cloud;                  // points by SPEC §2 with p, θ, then the pose; alpha/beta/intensity filled
   size_t scans = 0;             // LMDscandata frames used
   size_t beams = 0;             // beams in those frames (valid or not)
+  size_t scans_missed = 0;      // scans the device counted between those frames but never delivered
   bool partial = false;         // the sweep ended early (connection lost, scanner timeout); points kept
   std::string message;          // why it ended early
   double trigger_time_s = 0;    // what wait_for_start returned (0 without one)

@@ -389,6 +389,7 @@ DemoResult runDemo(const DemoOptions& o, const DemoLog& log_fn, const Progress& 
         row.partial = s.partial;
         row.start_spread_ms = spread_ms;
         if (s.partial) result.warnings.push_back(tag + " " + u.config.name + ": partial sweep (" + s.message + ")");
+        for (const std::string& w : s.warnings) result.warnings.push_back(tag + " " + u.config.name + ": " + w);
 
         log(tag + ": " + u.config.name + ": registering on the tunnel walls");
         BoatRegistrationParams bp;

@@ -110,6 +110,7 @@ void run(const ScanOptions& o) {
                 {"samples", samples.filename().string()},
                 {"points", s.points.size()},
                 {"scans", s.scans},
+                {"scans_missed", s.scans_missed},
                 {"partial", s.partial},
                 {"beta_start_deg", s.beta_start_deg},
                 {"beta_end_deg", s.beta_end_deg},
@@ -124,6 +125,7 @@ void run(const ScanOptions& o) {
       }
       std::printf("%s: %zu points from %zu scans, beta %.2f..%.2f deg%s\n", units[i].name.c_str(), s.points.size(),
                   s.scans, s.beta_start_deg, s.beta_end_deg, s.partial ? " (PARTIAL)" : "");
+      for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s: %s\n", units[i].name.c_str(), w.c_str());
     }
     doc["units"].push_back(u);
   }

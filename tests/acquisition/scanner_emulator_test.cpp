@@ -209,6 +209,50 @@ TEST(ScannerEmulator, StreamsRayCastRangesAtTheConfiguredRate) {
   EXPECT_TRUE(cola.next(0.2).empty());
 }
 
+// A host too slow to compute 50 Hz (30 ms more per scan than the 20 ms period) falls behind; past
+// max_lag_s the emulator drops scans as a device drops what its output cannot send. The scan counter
+// still counts them, every scan sent keeps its own start stamp, and none is sent later than the lag
+// allows, so the stream keeps to the turntable's time instead of lagging ever further behind it.
+TEST(ScannerEmulator, AHostTooSlowForTheRateDropsScansInsteadOfLagging) {
+  ScannerEmulatorParams p = params(ScannerModel::Lms511);
+  p.slow_host_s = 0.03;
+  p.max_lag_s = 0.1;
+  ScannerEmulator emu(wallScene(), p);
+  RawCola cola(emu.port(), ColaDialect::kBinary);
+  const auto ask = [&](const std::string& type, const std::string& name, const ColaWriter& w) {
+    cola.send(colaPayload(type, name, w.bytes()));
+    return splitColaTelegram(cola.next(3.0, "sSN"));
+  };
+  using W = ColaWriter;
+  ask("sMN", "SetAccessMode", W(ColaDialect::kBinary).u8(3).u32(0xF4724744u));
+  ask("sMN", "mLMPsetscancfg", W(ColaDialect::kBinary).u32(5000).u16(1).u32(10000).i32(600000).i32(1200000));
+  ask("sMN", "LMCstartmeas", W(ColaDialect::kBinary));
+  ask("sMN", "Run", W(ColaDialect::kBinary));
+  ask("sEN", "LMDscandata", W(ColaDialect::kBinary).u8(1));
+  std::vector<ScanData> scans;
+  while (scans.size() < 40) {
+    const std::string s = cola.next(3.0);
+    ASSERT_FALSE(s.empty());
+    if (isScanDataTelegram(s)) scans.push_back(decodeScanData(s, ColaDialect::kBinary));
+  }
+  uint64_t gaps = 0;
+  for (size_t k = 1; k < scans.size(); ++k) {
+    const uint16_t step = static_cast<uint16_t>(scans[k].scan_counter - scans[k - 1].scan_counter);
+    ASSERT_GE(step, 1u);
+    gaps += step - 1u;
+    // Each scan's start stamp stands `step` periods after the previous one: a dropped scan is a gap in time.
+    EXPECT_EQ(scans[k].time_since_startup_us - scans[k - 1].time_since_startup_us, 20000u * step);
+    // Sent within the lag allowed, plus one period of measuring and the slow host's own time, and 150 ms
+    // of scheduling slack for a loaded machine. (Without dropping, the 40th scan would go 0.44 s late.)
+    EXPECT_LT(scans[k].time_of_transmission_us - scans[k].time_since_startup_us, (0.1 + 0.02 + 0.03 + 0.15) * 1e6);
+  }
+  // The 40 sends, each ≥ 30 ms, span ≥ 1.17 s. A start stamp precedes its send by ≥ 50 ms (a period and
+  // the slow host) and by ≤ 150 ms (plus the lag allowed), so the stamps span ≥ 1.07 s, 53.5 periods, of
+  // which 39 steps were sent: at least 15 scans were dropped.
+  EXPECT_GE(gaps, 15u);
+  EXPECT_GE(emu.scansDropped(), gaps);
+}
+
 TEST(ScannerEmulator, AsciiDialectAndErrors) {
   ScannerEmulator emu(wallScene(), params(ScannerModel::Lms111));
   RawCola cola(emu.port(), ColaDialect::kAscii);

@@ -112,6 +112,51 @@ TEST(RayCaster, MatchesBruteForceOnTheTunnelScene) {
   EXPECT_GT(sail_hits, 100);
 }
 
+// A bundle gives each ray what a cast of it alone gives: footprint-like bundles (rays a few milliradians
+// apart, as a beam's rim), bundles of unrelated rays that part at the first node, axis-parallel rays
+// (zero direction components) and a zero direction, which hits nothing.
+TEST(RayCaster, ABundleGivesEachRayItsOwnCast) {
+  const Scene s = builtInTunnelScene();
+  const RayCaster caster(s);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  size_t hits = 0, bundles = 0;
+  for (int i = 0; i < 300; ++i) {
+    Vec3 o[RayCaster::kMaxBundle], d[RayCaster::kMaxBundle];
+    const size_t n = 1 + i % RayCaster::kMaxBundle;
+    const Vec3 o0(-2.5 + 0.3 * u(rng), -2.0 + 0.3 * u(rng), 1.0 + 0.3 * u(rng));
+    const Vec3 d0 = Vec3(0.3 * u(rng) - 0.2, 0.6 * u(rng), 1.4 + 1.2 * u(rng)) - o0;
+    for (size_t r = 0; r < n; ++r) {
+      if (i % 3 == 2) {  // unrelated rays from anywhere in the chamber
+        o[r] = Vec3(3 * u(rng), 3 * u(rng), 1.5 + u(rng));
+        d[r] = Vec3(u(rng), u(rng), u(rng));
+      } else {  // a footprint: 7 mm and 2.5 mrad about the axis
+        o[r] = o0 + 0.007 * Vec3(u(rng), u(rng), u(rng));
+        d[r] = d0.normalized() + 0.0025 * Vec3(u(rng), u(rng), u(rng));
+      }
+    }
+    if (i == 5) d[1] = Vec3(0, 0, 1);      // parallel to two slab pairs
+    if (i == 13) d[2] = Vec3(1, 0, 0);
+    if (i == 21) d[3] = Vec3::Zero();      // no direction: no hit
+    RayHit out[RayCaster::kMaxBundle];
+    caster.castBundle(o, d, n, out);
+    ++bundles;
+    for (size_t r = 0; r < n; ++r) {
+      const RayHit one = caster.cast(o[r], d[r]);
+      ASSERT_EQ(out[r].hit, one.hit) << "bundle " << i << " ray " << r;
+      if (!one.hit) continue;
+      ++hits;
+      EXPECT_EQ(out[r].distance_m, one.distance_m) << "bundle " << i << " ray " << r;
+      EXPECT_EQ(out[r].object, one.object) << "bundle " << i << " ray " << r;
+      EXPECT_NEAR(out[r].normal.dot(one.normal), 1.0, 1e-12);
+    }
+  }
+  EXPECT_GT(hits, 1000u) << "over " << bundles << " bundles";
+  Vec3 o[RayCaster::kMaxBundle + 1], d[RayCaster::kMaxBundle + 1];
+  RayHit out[RayCaster::kMaxBundle + 1];
+  EXPECT_THROW(caster.castBundle(o, d, RayCaster::kMaxBundle + 1, out), InvalidInput);
+}
+
 TEST(SceneJson, ObjectsAndPresets) {
   const Scene s = parseSceneJson(R"({"name": "bench", "objects": [
       {"type": "box", "name": "cube", "material": "light_grey", "min": [1, 1, 0], "max": [1.5, 1.5, 0.5]},

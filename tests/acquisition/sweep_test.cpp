@@ -91,7 +91,10 @@ PlaneFit fitPlane(const std::vector<Vec3>& pts) {
   return f;
 }
 
-void checkPlaneSweep(BetaSource source, const std::string& protocol = "cola-b") {
+// `slow_host_s`: the emulator takes that long to compute each scan (longer than the 20 ms period), and drops
+// the scans it is more than `max_lag_s` late for. The sweep is left in `out` when given.
+void checkPlaneSweep(BetaSource source, const std::string& protocol = "cola-b", double slow_host_s = 0,
+                     double max_lag_s = 0.25, Sweep* out = nullptr) {
   UnitConfig u = compactUnit(0.12, 25);
   u.beta_source = source;
   u.protocol = protocol;
@@ -100,10 +103,16 @@ void checkPlaneSweep(BetaSource source, const std::string& protocol = "cola-b") 
   Scene scene;
   const Vec3 c[4] = {Vec3(-20, 3, -20), Vec3(20, 3, -20), Vec3(20, 3, 20), Vec3(-20, 3, 20)};
   scene.objects.push_back({"wall", Material::Cloth, makeQuad(u.pose * c[0], u.pose * c[1], u.pose * c[2], u.pose * c[3])});
-  Rig rig(scene, u, emulatorFor(u), fastTable());
+  ScannerEmulatorParams sp = emulatorFor(u);
+  sp.slow_host_s = slow_host_s;
+  sp.max_lag_s = max_lag_s;
+  Rig rig(scene, u, sp, fastTable());
   const Sweep s = runSweep(rig.unit);
+  if (out) *out = s;
   ASSERT_FALSE(s.partial) << s.message;
-  EXPECT_GE(s.scans, 40u);  // ≈ 1.1 s of motion at 50 Hz
+  // ≈ 1.1 s of motion at 50 Hz, or at the rate a slow host computes its scans.
+  const double rate_hz = slow_host_s > 0 ? std::min(u.frequency_hz, 1.0 / slow_host_s) : u.frequency_hz;
+  EXPECT_GE(s.scans, static_cast<size_t>(0.7 * 1.1 * rate_hz));
   EXPECT_EQ(s.cloud.size(), s.points.size());
   EXPECT_GT(s.points.size(), 0.9 * s.beams);
   EXPECT_NEAR(s.beta_start_deg, -20, 1.0);
@@ -132,6 +141,33 @@ TEST(Sweep, PlaneWithEncoderBeta) { checkPlaneSweep(BetaSource::Encoder); }
 TEST(Sweep, PlaneWithTimestampBeta) { checkPlaneSweep(BetaSource::Timestamp); }
 
 TEST(Sweep, PlaneInColaA) { checkPlaneSweep(BetaSource::Encoder, "cola-a"); }
+
+// An emulator that cannot compute its scans at 50 Hz drops those it falls behind on, as a device drops what
+// its output cannot send. The sweep still covers the whole turntable move, the gaps in the scan counter are
+// counted and said, and β across a gap still puts the wall where it is.
+TEST(Sweep, AHostTooSlowForTheScanRateLosesScansNotTheEndOfTheSweep) {
+  for (BetaSource source : {BetaSource::Encoder, BetaSource::Timestamp}) {
+    SCOPED_TRACE(source == BetaSource::Encoder ? "encoder" : "timestamp");
+    Sweep s;
+    checkPlaneSweep(source, "cola-b", 0.03, 0.25, &s);
+    EXPECT_GT(s.scans_missed, 0u);
+    bool said = false;
+    for (const std::string& w : s.warnings) said = said || w.find("never arrived") != std::string::npos;
+    EXPECT_TRUE(said) << "the lost scans are said";
+  }
+}
+
+// A device whose output drains a backlog (here an emulator allowed to fall 10 s behind) delivers the end of
+// the sweep after the turntable stopped: the sweep waits for the scans taken while it moved, placed by their
+// own time stamps rather than by when they arrived, and none is lost.
+TEST(Sweep, ScansThatArriveLateArePlacedAtTheirOwnTime) {
+  for (BetaSource source : {BetaSource::Encoder, BetaSource::Timestamp}) {
+    SCOPED_TRACE(source == BetaSource::Encoder ? "encoder" : "timestamp");
+    Sweep s;
+    checkPlaneSweep(source, "cola-b", 0.03, 10.0, &s);
+    EXPECT_EQ(s.scans_missed, 0u);
+  }
+}
 
 TEST(Sweep, ScanLinesArriveWhileTheTurntableMoves) {
   UnitConfig u = compactUnit(0.12, 25);
