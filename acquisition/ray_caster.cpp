@@ -85,22 +85,24 @@ uint32_t RayCaster::build(uint32_t first, uint32_t count, std::vector<Vec3>& cen
   // The split a ray pays least for (surface-area heuristic over binned centroids): a wall's few large
   // triangles and a sail's many small ones end up in boxes of their own instead of one box spanning both.
   // Past kSahDepth, or with no split found, the median on the longest centroid axis keeps the depth bounded.
+  constexpr int kBins = 16;
+  const auto binOf = [&](uint32_t i, int k) {
+    return std::min(kBins - 1, static_cast<int>((centroids[i][k] - clo[k]) / (chi[k] - clo[k]) * kBins));
+  };
   int best_axis = -1, best_bin = 0;
   if (depth < kSahDepth) {
-    constexpr int kBins = 16;
     const auto area = [](const Vec3& a, const Vec3& b) {
       const Vec3 e = (b - a).cwiseMax(0.0);
       return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
     };
     double best_cost = area(lo, hi) * count;  // as a leaf of all of them (what a split must beat)
     for (int k = 0; k < 3; ++k) {
-      const double ext = chi[k] - clo[k];
-      if (!(ext > 0)) continue;
+      if (!(chi[k] - clo[k] > 0)) continue;
       Vec3 blo[kBins], bhi[kBins];
       uint32_t bn[kBins] = {};
       for (int b = 0; b < kBins; ++b) blo[b] = Vec3::Constant(std::numeric_limits<double>::infinity()), bhi[b] = -blo[b];
       for (uint32_t i = first; i < first + count; ++i) {
-        const int b = std::min(kBins - 1, static_cast<int>((centroids[i][k] - clo[k]) / ext * kBins));
+        const int b = binOf(i, k);
         const Triangle& t = tris_[i];
         for (const Vec3& p : {t.a, Vec3(t.a + t.e1), Vec3(t.a + t.e2)}) {
           blo[b] = blo[b].cwiseMin(p);
@@ -134,11 +136,8 @@ uint32_t RayCaster::build(uint32_t first, uint32_t count, std::vector<Vec3>& cen
     }
   }
   if (best_axis >= 0) {
-    const int k = best_axis;
-    const double ext = chi[k] - clo[k];
-    const auto split = std::partition(order.begin(), order.end(), [&](uint32_t i) {
-      return std::min(15, static_cast<int>((centroids[i][k] - clo[k]) / ext * 16)) <= best_bin;
-    });
+    const auto split =
+        std::partition(order.begin(), order.end(), [&](uint32_t i) { return binOf(i, best_axis) <= best_bin; });
     mid = first + static_cast<uint32_t>(split - order.begin());
   } else {
     std::nth_element(order.begin(), order.begin() + (mid - first), order.end(),
@@ -191,64 +190,13 @@ RayHit RayCaster::hitOf(const Triangle* t, double distance_m, const Vec3& d) {
 }
 
 RayHit RayCaster::cast(const Vec3& origin, const Vec3& direction, double min_m, double max_m) const {
-  RayHit best;
-  const double len = direction.norm();
-  if (!(len > 0) || !origin.allFinite()) return best;
-  const Vec3 d = direction / len;
-  const Vec3 inv(1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z());
-  const bool parallel = !inv.allFinite();  // a zero (or denormal) direction component
-  double t_best = max_m;
-  const Triangle* hit = nullptr;
-  // Nodes still to visit with where the ray enters them: a node entered beyond the nearest hit found
-  // since it was pushed holds nothing nearer, so its box need not be tested again.
-  struct Pending {
-    uint32_t node;
-    double t_enter;
-  };
-  Pending stack[64];
-  int top = 0;
-  double t_root = 0;
-  if (!hitsBox(nodes_[0].lo, nodes_[0].hi, origin, inv, parallel, t_best, t_root)) return best;
-  stack[top++] = {0, t_root};
-  while (top > 0) {
-    const Pending next = stack[--top];
-    if (next.t_enter > t_best) continue;
-    const Node& n = nodes_[next.node];
-    if (n.count > 0) {
-      for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-        double dist;
-        if (meets(tris_[i], origin, d, min_m, t_best, dist)) {
-          t_best = dist;
-          hit = &tris_[i];
-        }
-      }
-      continue;
-    }
-    // Visit the nearer child first (pushed last).
-    const uint32_t left = static_cast<uint32_t>(&n - nodes_.data()) + 1, right = n.first;
-    double tl = 0, tr = 0;
-    const bool hl = hitsBox(nodes_[left].lo, nodes_[left].hi, origin, inv, parallel, t_best, tl);
-    const bool hr = hitsBox(nodes_[right].lo, nodes_[right].hi, origin, inv, parallel, t_best, tr);
-    if (top + 2 > 64) throw AnalysisError("[RayCaster::cast] hierarchy deeper than 64 levels");
-    if (hl && hr) {
-      if (tl < tr) {
-        stack[top++] = {right, tr};
-        stack[top++] = {left, tl};
-      } else {
-        stack[top++] = {left, tl};
-        stack[top++] = {right, tr};
-      }
-    } else if (hl) {
-      stack[top++] = {left, tl};
-    } else if (hr) {
-      stack[top++] = {right, tr};
-    }
-  }
-  return hitOf(hit, t_best, d);
+  RayHit hit;
+  castBundle(&origin, &direction, 1, &hit, min_m, max_m);
+  return hit;
 }
 
 void RayCaster::castBundle(const Vec3* origins, const Vec3* directions, size_t count, RayHit* out,
-                           double min_m) const {
+                           double min_m, double max_m) const {
   if (count > kMaxBundle) throw InvalidInput("[RayCaster::castBundle] at most " + std::to_string(kMaxBundle) +
                                              " rays share a traversal (got " + std::to_string(count) + ")");
   Vec3 d[kMaxBundle], inv[kMaxBundle];
@@ -259,15 +207,17 @@ void RayCaster::castBundle(const Vec3* origins, const Vec3* directions, size_t c
   for (size_t r = 0; r < count; ++r) {
     out[r] = RayHit{};
     hit[r] = nullptr;
-    t_best[r] = std::numeric_limits<double>::infinity();
+    t_best[r] = max_m;
     const double len = directions[r].norm();
     if (!(len > 0) || !origins[r].allFinite()) continue;
     d[r] = directions[r] / len;
     inv[r] = Vec3(1.0 / d[r].x(), 1.0 / d[r].y(), 1.0 / d[r].z());
-    parallel[r] = !inv[r].allFinite();
+    parallel[r] = !inv[r].allFinite();  // a zero (or denormal) direction component
     live |= 1u << r;
   }
-  // As in cast(), with a mask of the rays that entered each pending node and where each entered it.
+  // Nodes still to visit, with the rays that entered each and where each entered it: a node a ray entered
+  // beyond the nearest hit it found since the node was pushed holds nothing nearer for that ray, so its box
+  // need not be tested again.
   struct Pending {
     uint32_t node, rays;
     double t_enter[kMaxBundle];

@@ -30,11 +30,11 @@ class RayCaster {
               double max_m = std::numeric_limits<double>::infinity()) const;
 
   // The nearest hits of `count` (≤ kMaxBundle) rays at once, out[i] as cast(origins[i], directions[i])
-  // gives it, in one traversal of the hierarchy: for a beam's footprint, rays that stay close together,
-  // this visits each node once instead of once per ray.
+  // gives it, in one traversal of the hierarchy (cast is a bundle of one): for a beam's footprint, rays
+  // that stay close together, the nodes are visited once for all of them.
   static constexpr size_t kMaxBundle = 8;
-  void castBundle(const Vec3* origins, const Vec3* directions, size_t count, RayHit* out,
-                  double min_m = 1e-6) const;
+  void castBundle(const Vec3* origins, const Vec3* directions, size_t count, RayHit* out, double min_m = 1e-6,
+                  double max_m = std::numeric_limits<double>::infinity()) const;
 
   size_t triangleCount() const { return tris_.size(); }
   size_t nodeCount() const { return nodes_.size(); }

@@ -213,9 +213,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
 
   // Scans taken before the move was commanded stand at the start angle: not part of the sweep.
   // Timestamp mode maps the scanner's clock to the host's by the smallest receive − transmission gap.
-  double clock_offset = std::numeric_limits<double>::infinity();
-  for (const ReceivedScan& r : scans)
-    clock_offset = std::min(clock_offset, r.host_time_s - r.data.time_of_transmission_us * 1e-6);
+  const double clock_offset = running_offset;  // over every scan received
   const bool encoder = unit.beta_source == BetaSource::Encoder;
   size_t used = 0;
   // Scans the device counted but never delivered: gaps in the scan counter between received scans.
