@@ -12,6 +12,12 @@
 #include <pcl/surface/gp3.h>
 #include <pcl/surface/mls.h>
 #include <sys/resource.h>
+#include <vtkCellArray.h>
+#include <vtkGenericCell.h>
+#include <vtkModifiedBSPTree.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
 
 #include <unistd.h>
 
@@ -24,6 +30,8 @@
 #include <map>
 #include <string>
 
+#include "acquisition/ray_caster.hpp"
+#include "acquisition/scene.hpp"
 #include "analysis/cleaning.hpp"
 #include "analysis/design_compare.hpp"
 #include "analysis/normals.hpp"
@@ -456,6 +464,129 @@ void BM_Db_BestTrimStep(benchmark::State& state) {
   runQuery(state, [&](Database& db) { return bestTrimSteps(db, 85, 105, TrimCriterion::DriveOverSide, 5); });
 }
 
+// ---- the emulator's ray casting: the built-in tunnel scene, ours against VTK's vtkModifiedBSPTree ----
+// The rays of an LMS511 sweep over the main from the demo's main unit: vertical scan planes at 1/6°
+// beam steps over the 190° fan, turned about the vertical shaft through 60° in `lines` scan lines
+// (the demo's 300-line sweep is 342,000 beams). Each beam is cast as the sensor model casts it: the
+// axis ray and four rim rays (exit radius 6 mm, half the 4.7 mrad divergence), five rays a beam.
+// Counters: build_ms (the hierarchy or locator), and on VTK's side the largest range difference
+// and the count of rays one caster hits and the other misses (grazing triangle edges).
+struct SweepRays {
+  std::vector<Vec3> origins, directions;  // five per beam: axis, then the four rim rays
+};
+
+const SweepRays& sweepRays(int lines) {
+  static std::map<int, SweepRays> cache;
+  auto it = cache.find(lines);
+  if (it != cache.end()) return it->second;
+  SweepRays r;
+  const Vec3 unit(-0.5, -3.0, 1.1), up = Vec3::UnitZ();
+  const double step = M_PI / 180.0 / 6.0, half_divergence = 0.5 * 4.7e-3, rim = 0.006;
+  for (int l = 0; l < lines; ++l) {
+    const double yaw = (60.0 + 60.0 * l / std::max(1, lines - 1)) * M_PI / 180.0;
+    const Vec3 across(std::cos(yaw), std::sin(yaw), 0.0);
+    for (double a = -5.0 * M_PI / 180.0; a <= 185.0 * M_PI / 180.0 + 1e-9; a += step) {
+      const Vec3 d = std::cos(a) * across + std::sin(a) * up;
+      const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
+      const Vec3 rims[4] = {u, Vec3(-u), v, Vec3(-v)};
+      r.origins.push_back(unit);
+      r.directions.push_back(d);
+      for (const Vec3& w : rims) {
+        r.origins.push_back(unit + rim * w);
+        r.directions.push_back((d + half_divergence * w).normalized());
+      }
+    }
+  }
+  return cache.emplace(lines, std::move(r)).first->second;
+}
+
+constexpr double kLmsMaxRangeM = 80.0;
+
+double millisecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void BM_Ours_RayCast(benchmark::State& state) {
+  const Scene scene = builtInTunnelScene();
+  const auto t0 = std::chrono::steady_clock::now();
+  const RayCaster caster(scene);
+  const double build_ms = millisecondsSince(t0);
+  const SweepRays& r = sweepRays(static_cast<int>(state.range(0)));
+  size_t hits = 0;
+  for (auto _ : state)
+    for (size_t i = 0; i < r.origins.size(); ++i)
+      hits += caster.cast(r.origins[i], r.directions[i], 1e-6, kLmsMaxRangeM).hit;
+  benchmark::DoNotOptimize(hits);
+  state.counters["build_ms"] = build_ms;
+  state.counters["triangles"] = static_cast<double>(caster.triangleCount());
+  finish(state, r.origins.size());
+}
+
+// The same rays a beam at a time, as the emulator casts them: one traversal for its five rays.
+void BM_Ours_RayCastFootprint(benchmark::State& state) {
+  const RayCaster caster(builtInTunnelScene());
+  const SweepRays& r = sweepRays(static_cast<int>(state.range(0)));
+  size_t hits = 0;
+  RayHit out[5];
+  for (auto _ : state)
+    for (size_t i = 0; i < r.origins.size(); i += 5) {
+      caster.castBundle(&r.origins[i], &r.directions[i], 5, out, 1e-6, kLmsMaxRangeM);
+      for (const RayHit& h : out) hits += h.hit;
+    }
+  benchmark::DoNotOptimize(hits);
+  finish(state, r.origins.size());
+}
+
+void BM_Vtk_RayCast(benchmark::State& state) {
+  const Scene scene = builtInTunnelScene();
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkCellArray> cells;
+  for (const SceneObject& o : scene.objects) {
+    const vtkIdType base = points->GetNumberOfPoints();
+    for (const Vec3& v : o.mesh.vertices) points->InsertNextPoint(v.x(), v.y(), v.z());
+    for (const auto& t : o.mesh.triangles) {
+      const vtkIdType ids[3] = {base + t[0], base + t[1], base + t[2]};
+      cells->InsertNextCell(3, ids);
+    }
+  }
+  vtkNew<vtkPolyData> mesh;
+  mesh->SetPoints(points);
+  mesh->SetPolys(cells);
+  const auto t0 = std::chrono::steady_clock::now();
+  vtkNew<vtkModifiedBSPTree> tree;
+  tree->SetDataSet(mesh);
+  tree->LazyEvaluationOff();  // built here, not on the first query
+  tree->BuildLocator();
+  vtkNew<vtkGenericCell> scratch;  // one cell reused by every query
+  const double build_ms = millisecondsSince(t0);
+  const SweepRays& r = sweepRays(static_cast<int>(state.range(0)));
+  std::vector<double> range(r.origins.size());
+  for (auto _ : state)
+    for (size_t i = 0; i < r.origins.size(); ++i) {
+      const Vec3 far = r.origins[i] + kLmsMaxRangeM * r.directions[i];
+      double t = 0, x[3], pcoords[3];
+      int sub = 0;
+      vtkIdType cell = -1;
+      const bool hit = tree->IntersectWithLine(r.origins[i].data(), far.data(), 0.0, t, x, pcoords, sub, cell, scratch);
+      range[i] = hit ? t * kLmsMaxRangeM : -1;
+    }
+  // Agreement with ours, outside the timing.
+  const RayCaster caster(scene);
+  double max_diff_mm = 0;
+  size_t disagree = 0;
+  for (size_t i = 0; i < r.origins.size(); ++i) {
+    const RayHit h = caster.cast(r.origins[i], r.directions[i], 1e-6, kLmsMaxRangeM);
+    if (h.hit != (range[i] >= 0))
+      ++disagree;
+    else if (h.hit)
+      max_diff_mm = std::max(max_diff_mm, 1e3 * std::abs(h.distance_m - range[i]));
+  }
+  state.counters["build_ms"] = build_ms;
+  state.counters["max_range_diff_mm"] = max_diff_mm;
+  state.counters["hit_miss_disagreements"] = static_cast<double>(disagree);
+  finish(state, r.origins.size());
+}
+
 #define SIZES Arg(50'000)->Arg(200'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->Iterations(1)
 BENCHMARK(BM_Ours_Normals)->SIZES;
 BENCHMARK(BM_Pcl_Normals)->SIZES;
@@ -472,6 +603,10 @@ BENCHMARK(BM_Ours_WholeAnalysisEveryPoint)->SIZES;
 BENCHMARK(BM_Pcl_WholeAnalysis)->SIZES;
 BENCHMARK(BM_Ours_SignedDistance)->SIZES;
 BENCHMARK(BM_Ours_Registration)->Arg(50'000)->Arg(200'000)->Unit(benchmark::kMillisecond)->Iterations(1);
+#define RAYS Arg(30)->Arg(300)->Unit(benchmark::kMillisecond)->Iterations(1)
+BENCHMARK(BM_Ours_RayCast)->RAYS;
+BENCHMARK(BM_Ours_RayCastFootprint)->RAYS;
+BENCHMARK(BM_Vtk_RayCast)->RAYS;
 #define QUERY Unit(benchmark::kMillisecond)
 BENCHMARK(BM_Db_ScansBySailAndAwa)->QUERY;
 BENCHMARK(BM_Db_ScansBySailTypeAndControl)->QUERY;
