@@ -32,6 +32,7 @@
 
 #include "acquisition/ray_caster.hpp"
 #include "acquisition/scene.hpp"
+#include "acquisition/sensor_model.hpp"
 #include "analysis/cleaning.hpp"
 #include "analysis/design_compare.hpp"
 #include "analysis/normals.hpp"
@@ -468,7 +469,8 @@ void BM_Db_BestTrimStep(benchmark::State& state) {
 // The rays of an LMS511 sweep over the main from the demo's main unit: vertical scan planes at 1/6°
 // beam steps over the 190° fan, turned about the vertical shaft through 60° in `lines` scan lines
 // (the demo's 300-line sweep is 342,000 beams). Each beam is cast as the sensor model casts it: the
-// axis ray and four rim rays (exit radius 6 mm, half the 4.7 mrad divergence), five rays a beam.
+// axis ray and four rim rays (at the exit radius, half the divergence out), five rays a beam; the
+// fan, steps, divergence, exit window and range are the LMS511's data-sheet facts (scannerSpec).
 // Counters: build_ms (the hierarchy or locator), and on VTK's side the largest range difference
 // and the count of rays one caster hits and the other misses (grazing triangle edges).
 struct SweepRays {
@@ -480,12 +482,14 @@ const SweepRays& sweepRays(int lines) {
   auto it = cache.find(lines);
   if (it != cache.end()) return it->second;
   SweepRays r;
+  const ScannerSpec lms511 = scannerSpec(ScannerModel::Lms511);
   const Vec3 unit(-0.5, -3.0, 1.1), up = Vec3::UnitZ();
-  const double step = M_PI / 180.0 / 6.0, half_divergence = 0.5 * 4.7e-3, rim = 0.006;
+  const double deg = M_PI / 180.0, step = lms511.default_resolution_deg * deg;
+  const double half_divergence = 0.5 * lms511.beam_divergence_rad, rim = 0.5 * lms511.exit_diameter_m;
   for (int l = 0; l < lines; ++l) {
-    const double yaw = (60.0 + 60.0 * l / std::max(1, lines - 1)) * M_PI / 180.0;
+    const double yaw = (60.0 + 60.0 * l / std::max(1, lines - 1)) * deg;
     const Vec3 across(std::cos(yaw), std::sin(yaw), 0.0);
-    for (double a = -5.0 * M_PI / 180.0; a <= 185.0 * M_PI / 180.0 + 1e-9; a += step) {
+    for (double a = lms511.first_angle_deg * deg; a <= lms511.last_angle_deg * deg + 1e-9; a += step) {
       const Vec3 d = std::cos(a) * across + std::sin(a) * up;
       const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
       const Vec3 rims[4] = {u, Vec3(-u), v, Vec3(-v)};
@@ -500,7 +504,7 @@ const SweepRays& sweepRays(int lines) {
   return cache.emplace(lines, std::move(r)).first->second;
 }
 
-constexpr double kLmsMaxRangeM = 80.0;
+const double kLmsMaxRangeM = scannerSpec(ScannerModel::Lms511).max_range_m;
 
 double millisecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
