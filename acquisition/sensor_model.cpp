@@ -67,21 +67,32 @@ EmulatedSensor::EmulatedSensor(const Scene& scene, const SensorModelParams& para
   for (const SceneObject& o : scene.objects) materials_.push_back(o.material);
 }
 
+BeamFootprint beamFootprint(const ScannerSpec& spec, const Vec3& origin, const Vec3& direction) {
+  BeamFootprint b;
+  const Vec3 u = direction.unitOrthogonal(), v = direction.cross(u);
+  const double half = 0.5 * spec.beam_divergence_rad, rim = 0.5 * spec.exit_diameter_m;
+  b.rim_dirs[0] = u;
+  b.rim_dirs[1] = -u;
+  b.rim_dirs[2] = v;
+  b.rim_dirs[3] = -v;
+  b.origins[0] = origin;
+  b.directions[0] = direction;
+  for (int k = 0; k < 4; ++k) {
+    b.origins[k + 1] = origin + rim * b.rim_dirs[k];
+    b.directions[k + 1] = direction + half * b.rim_dirs[k];
+  }
+  return b;
+}
+
 BeamReturn EmulatedSensor::measure(const Vec3& origin, const Vec3& direction, std::mt19937_64& rng) const {
   BeamReturn out;
   const Vec3 d = direction.normalized();
-  // Footprint: the axis ray plus four rays on the rim of the beam (exit radius at the window, half the
-  // divergence beyond), weights 2:1:1:1:1, cast together (they share one traversal of the scene).
-  const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
-  const double half = 0.5 * spec_.beam_divergence_rad, rim = 0.5 * spec_.exit_diameter_m;
-  const Vec3 rim_dirs[4] = {u, Vec3(-u), v, Vec3(-v)};
-  Vec3 origins[5] = {origin}, dirs[5] = {d};
-  for (int k = 0; k < 4; ++k) {
-    origins[k + 1] = origin + rim * rim_dirs[k];
-    dirs[k + 1] = d + half * rim_dirs[k];
-  }
+  // Footprint: the axis ray plus four rays on the rim of the beam, weights 2:1:1:1:1, cast together
+  // (they share one traversal of the scene).
+  const BeamFootprint beam = beamFootprint(spec_, origin, d);
+  const double half = 0.5 * spec_.beam_divergence_rad;
   RayHit hits[5];
-  caster_.castBundle(origins, dirs, params_.mixed_pixels ? 5 : 1, hits);
+  caster_.castBundle(beam.origins, beam.directions, params_.mixed_pixels ? 5 : 1, hits);
   const RayHit& axis = hits[0];
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   std::normal_distribution<double> gauss(0.0, 1.0);
@@ -100,13 +111,12 @@ BeamReturn EmulatedSensor::measure(const Vec3& origin, const Vec3& direction, st
     bool straddles = false;
     for (int k = 0; k < 4; ++k) {
       const RayHit& h = hits[k + 1];
-      const Vec3& w = rim_dirs[k];
       if (!h.hit) {
         straddles = true;
         continue;
       }
       // The rim ray's range as the device would see it: along the axis direction.
-      const double r = h.distance_m * (d + half * w).normalized().dot(d);
+      const double r = h.distance_m * beam.directions[k + 1].normalized().dot(d);
       if (h.object != axis.object || std::abs(r - axis.distance_m) > spread_allowed) straddles = true;
       sum += r;
       weight += 1.0;

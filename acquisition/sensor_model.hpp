@@ -31,6 +31,17 @@ struct ScannerSpec {
 };
 ScannerSpec scannerSpec(ScannerModel model);
 
+// A beam's footprint as the emulator casts it: ray 0 is the axis from `origin`
+// along the unit `direction`; rays 1-4 leave the exit window's rim (offsets
+// rim_dirs[k] · exit radius) half the divergence out. Their directions are
+// d + (divergence / 2) · rim_dirs[k], not normalised: a cast along them
+// measures distance along the unit direction all the same.
+struct BeamFootprint {
+  Vec3 origins[5], directions[5];
+  Vec3 rim_dirs[4];  // unit, across the axis: u, −u, v, −v
+};
+BeamFootprint beamFootprint(const ScannerSpec& spec, const Vec3& origin, const Vec3& direction);
+
 // Per material (SPEC §3): 1σ random error, range bias, reflectivity in [0, 1].
 struct MaterialResponse {
   double sigma_m, bias_m, reflectivity;

@@ -485,19 +485,15 @@ const SweepRays& sweepRays(int lines) {
   const ScannerSpec lms511 = scannerSpec(ScannerModel::Lms511);
   const Vec3 unit(-0.5, -3.0, 1.1), up = Vec3::UnitZ();
   const double deg = M_PI / 180.0, step = lms511.default_resolution_deg * deg;
-  const double half_divergence = 0.5 * lms511.beam_divergence_rad, rim = 0.5 * lms511.exit_diameter_m;
   for (int l = 0; l < lines; ++l) {
     const double yaw = (60.0 + 60.0 * l / std::max(1, lines - 1)) * deg;
     const Vec3 across(std::cos(yaw), std::sin(yaw), 0.0);
     for (double a = lms511.first_angle_deg * deg; a <= lms511.last_angle_deg * deg + 1e-9; a += step) {
       const Vec3 d = std::cos(a) * across + std::sin(a) * up;
-      const Vec3 u = d.unitOrthogonal(), v = d.cross(u);
-      const Vec3 rims[4] = {u, Vec3(-u), v, Vec3(-v)};
-      r.origins.push_back(unit);
-      r.directions.push_back(d);
-      for (const Vec3& w : rims) {
-        r.origins.push_back(unit + rim * w);
-        r.directions.push_back((d + half_divergence * w).normalized());
+      const BeamFootprint beam = beamFootprint(lms511, unit, d);
+      for (int k = 0; k < 5; ++k) {
+        r.origins.push_back(beam.origins[k]);
+        r.directions.push_back(beam.directions[k].normalized());
       }
     }
   }
