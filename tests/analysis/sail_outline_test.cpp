@@ -120,26 +120,21 @@ TEST(SailOutline, AClosedSurfaceHasNoBoundary) {
 }
 
 // Flat 3 m x 9 m sheets sampled at random at a 40,000-point mainsail's density
-// (1,500 points/m²): the outermost samples along each edge lie inside it by
-// random gaps of about a centimetre. The fitted luff and leech must lie on the
-// true edges to about a millimetre (a tenth of a degree of twist on an upper
-// section's 0.9 m chord is 1.5 mm): the edge's recess, estimated along it from
-// windows of ~90 samples whose outermost lies a ~2.4 mm gap inside, fitted with
-// up to 4 coefficients over ~14 windows, is known to ~1.3 mm. The bound is on
-// the RMS pooled over five sheets; one least-squares curve through the boundary
-// samples with a single recess left about 2.6 mm.
-TEST(SailOutline, EdgesOfRandomlySampledSheetsLieOnTheirTrueEdges) {
+// (ρ = 1,500 points/m²), each sample moved across the sheet by Gaussian noise of
+// `sigma_x`: the RMS distance (m) of the fitted luff (x = width) and leech (x = 0)
+// from the true edges, away from the corners' rounding, pooled over five sheets.
+double sheetEdgeRms(double sigma_x) {
   constexpr double kWidth = 3.0, kHeight = 9.0;
   double sum2 = 0;
   int n = 0;
   for (uint64_t seed = 11; seed <= 15; ++seed) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> x(0.0, kWidth), z(0.0, kHeight);
+    std::normal_distribution<double> noise(0.0, 1.0);
     Cloud sheet;
-    for (int i = 0; i < 40'500; ++i) sheet.points.emplace_back(x(rng), 0.0, z(rng));
+    for (int i = 0; i < 40'500; ++i) sheet.points.emplace_back(x(rng) + sigma_x * noise(rng), 0.0, z(rng));
     const SailOutline o = extractOutline(reconstructSurface(sheet).mesh);
-    ASSERT_TRUE(o.has_peak) << "seed " << seed;  // a rectangle: four corners
-    // The luff (x = width) and the leech (x = 0), away from the corners' rounding.
+    EXPECT_TRUE(o.has_peak) << "seed " << seed;  // a rectangle: four corners
     for (const auto& [edge, at] : {std::pair{&o.luff, kWidth}, {&o.leech, 0.0}})
       for (const Vec3& p : *edge)
         if (p.z() > 0.5 && p.z() < kHeight - 0.5) {
@@ -147,9 +142,27 @@ TEST(SailOutline, EdgesOfRandomlySampledSheetsLieOnTheirTrueEdges) {
           ++n;
         }
   }
-  ASSERT_GT(n, 500);
-  EXPECT_LT(std::sqrt(sum2 / n), 0.0015);
+  EXPECT_GT(n, 500);
+  return std::sqrt(sum2 / std::max(1, n));
 }
+
+// The outermost samples along a clean edge lie inside it by random gaps of about
+// a centimetre; a tenth of a degree of twist on an upper section's 0.9 m chord is
+// 1.5 mm. The polynomial resting on the outermost samples (their lower envelope,
+// up to 6 coefficients over the ~8.5 m between the corners' rounding) lies inside
+// the edge by the band holding as many samples as it has coefficients,
+// 6 / (ρ · 8.5 m) = 0.47 mm, with about as much spread once moved out by that:
+// the edges must lie within 1 mm RMS, twice that. (The recess estimated from
+// windows of ~90 samples alone came to 1.16 mm; one least-squares curve through
+// the boundary samples with a single recess, to about 2.6 mm.)
+TEST(SailOutline, EdgesOfRandomlySampledSheetsLieOnTheirTrueEdges) { EXPECT_LT(sheetEdgeRms(0.0), 0.0010); }
+
+// Noise across the edge moves the outermost samples out by its extremes: with
+// 3 mm of it, 2-3σ beyond the edge. The envelope resting on them alone put the
+// edges 3.9 mm out (RMS); the edges must stay within 2.5 mm, under the noise's
+// σ, as the windows' estimates do (each the outermost of ~90 samples, averaged
+// along the edge).
+TEST(SailOutline, NoiseAcrossAnEdgeDoesNotPushItOut) { EXPECT_LT(sheetEdgeRms(0.003), 0.0025); }
 
 TEST(SailOutline, ANotchCutIntoAnEdgeIsNoCorner) {
   // A 3 m × 9 m sheet (a square top's shape) with a wedge 25 cm deep and 24 cm wide
