@@ -753,6 +753,20 @@ double frontierWindow(const CornerCurve& c, bool from_corner, double spacing) {
   return std::clamp((c.to - start) / kFrontierFewestWindows, spacing, kFrontierWindowSpacings * spacing);
 }
 
+// How deep a corner curve's strip reaches in at distance dw from the corner
+// (point p, tangent t, inward `in`): `strip`, or half the sail's width there where
+// that is less (how far in the other edge's curve passes, within half a window
+// along), so that the other edge's samples stay out of it.
+double stripDepth(const CornerCurve& other, double dw, const Vec3& p, const Vec3& t, const Vec3& in, double window,
+                  double strip) {
+  double across = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= 60; ++i) {
+    const Vec3 q = other.curve.at(3.0 * dw * i / 60.0) - p;
+    if (std::abs(q.dot(t)) <= 0.5 * window) across = std::min(across, q.dot(in));
+  }
+  return std::min(strip, 0.5 * across);
+}
+
 // A corner curve fitted through the boundary vertices carries their scatter (a
 // gap each: about a centimetre on a 40,000-point gennaker), and fitted over 60
 // boundary spacings it cannot follow how an edge bends on the last few metres
@@ -804,13 +818,7 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
     const Vec3 p = c.curve.at(dw), t = c.curve.tangent(dw);
     const Across across_edge = acrossAt(p, p, t, smp, near, near_d2);
     const Vec3& in = across_edge.in;
-    // Half the sail's width here: how far in the other edge's curve passes.
-    double across = std::numeric_limits<double>::infinity();
-    for (int i = 0; i <= 60; ++i) {
-      const Vec3 q = other.curve.at(3.0 * dw * i / 60.0) - p;
-      if (std::abs(q.dot(t)) <= 0.5 * window) across = std::min(across, q.dot(in));
-    }
-    const double D = std::min(strip, 0.5 * across);
+    const double D = stripDepth(other, dw, p, t, in, window, strip);
     if (!(D > 0.5 * spacing)) continue;
     smp.tree.withinRadius(p, std::hypot(D + strip, 0.5 * window), idx, d2);
     double least = std::numeric_limits<double>::infinity();
@@ -905,12 +913,7 @@ CornerCurve ontoEnvelope(const CornerCurve& c, const CornerCurve& other, const S
   for (double dw = 0.5 * spacing; dw + 0.5 * spacing <= c.to + 1e-9 * spacing; dw += spacing) {
     const Vec3 p = c.curve.at(dw), t = c.curve.tangent(dw);
     const Vec3 inward = acrossAt(p, p, t, smp, near, near_d2).in;
-    double across = std::numeric_limits<double>::infinity();
-    for (int i = 0; i <= 60; ++i) {
-      const Vec3 q = other.curve.at(3.0 * dw * i / 60.0) - p;
-      if (std::abs(q.dot(t)) <= 0.5 * spacing) across = std::min(across, q.dot(inward));
-    }
-    const double D = std::min(strip, 0.5 * across);
+    const double D = stripDepth(other, dw, p, t, inward, spacing, strip);
     if (!(D > 0.5 * spacing)) continue;
     centre.push_back(dw);
     at.push_back(p);
