@@ -47,4 +47,16 @@ Vec3 triangleNormal(const Mesh& mesh, size_t t) {
   return n / norm;
 }
 
+std::vector<Vec3> vertexNormals(const Mesh& mesh) {
+  std::vector<Vec3> n(mesh.vertices.size(), Vec3::Zero());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto c = corners(mesh, t, "vertexNormals");
+    const Vec3 fn = (c[1] - c[0]).cross(c[2] - c[0]);  // twice the area, along the normal
+    for (uint32_t v : mesh.triangles[t]) n[v] += fn;
+  }
+  for (Vec3& v : n)
+    if (v.norm() > 0) v.normalize();
+  return n;
+}
+
 }  // namespace sailshape

@@ -21,4 +21,8 @@ double meshArea(const Mesh& mesh);
 // Unit normal of triangle t (zero vector for a degenerate triangle).
 Vec3 triangleNormal(const Mesh& mesh, size_t t);
 
+// Area-weighted unit normal of each vertex (zero for a vertex of no triangle, or
+// where its triangles' normals cancel), one per mesh.vertices entry.
+std::vector<Vec3> vertexNormals(const Mesh& mesh);
+
 }  // namespace sailshape

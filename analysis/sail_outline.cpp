@@ -158,18 +158,6 @@ Vec3 loopPointAt(const std::vector<Vec3>& pts, const std::vector<double>& cum, d
   return pts[i] + t * (pts[j] - pts[i]);
 }
 
-// Area-weighted vertex normals.
-std::vector<Vec3> vertexNormals(const Mesh& mesh) {
-  std::vector<Vec3> n(mesh.vertices.size(), Vec3::Zero());
-  for (const auto& t : mesh.triangles) {
-    const Vec3 fn = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
-    for (uint32_t v : t) n[v] += fn;
-  }
-  for (Vec3& v : n)
-    if (v.norm() > 0) v.normalize();
-  return n;
-}
-
 // Least-squares polynomials of one variable s, one per column of values:
 // Σ_k c_k u^k with u = (s − mid) / half, the samples' range mapped onto [−1, 1].
 struct Polynomial {

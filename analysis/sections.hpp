@@ -87,6 +87,13 @@ void checkSectionParams(const SectionParams& params);
 // bad parameters and AnalysisError when no section can be measured.
 SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const SectionParams& params = {});
 
+// Where the plane through `point` with unit `normal` cuts the mesh: polylines of
+// points on the mesh's edges, chained through the edges the cut triangles share
+// (open ones first, then loops). Each point lies on the curved edge the vertex
+// normals describe (the cubic leaving each end in its tangent plane), not on the
+// straight one, which sags below a curved surface. Empty when the plane misses.
+std::vector<std::vector<Vec3>> planeCuts(const Mesh& mesh, const Vec3& point, const Vec3& normal);
+
 // Twist per SPEC §5: angle in the XY plane between +X and the chord vector from
 // leech to luff, degrees in [0, 180].
 double twistDeg(const Vec3& luff_point, const Vec3& leech_point);
