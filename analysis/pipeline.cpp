@@ -335,7 +335,13 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     StageTimer t(a, "sections", a.mesh.vertices.size());
     SectionParams sp = p.sections;
     sp.sensor_sigma_m = p.sensor_sigma_m;
-    if (p.smooth) sp.noise_correlation_m = a.smoothing_stats.mean_radius_m;
+    if (p.smooth) {
+      sp.noise_correlation_m = a.smoothing_stats.mean_radius_m;
+      // A quadratic fitted to k points of noise σ over a disc is known at its centre to
+      // 2σ/√k (the constant term's variance, 4σ²/k, with the curvature terms free).
+      const Smoothing& sm = a.smoothing_stats;
+      if (sm.k_used > 0) sp.surface_sigma_m = 2.0 * sm.measured_noise_m / std::sqrt(static_cast<double>(sm.k_used));
+    }
     a.sections = cutSections(a.mesh, a.outline, sp);
     t.finish(a.sections.sections.size(), a.sections.warnings);
   }

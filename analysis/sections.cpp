@@ -457,6 +457,7 @@ void checkSectionParams(const SectionParams& p) {
   need(p.normal_radius > 0 && p.normal_radius <= 0.5, "normal_radius must be in (0, 0.5]", p.normal_radius);
   need(p.sensor_sigma_m >= 0, "sensor_sigma_m must be >= 0 (0: an exact surface)", p.sensor_sigma_m);
   need(p.noise_correlation_m >= 0, "noise_correlation_m must be >= 0", p.noise_correlation_m);
+  need(p.surface_sigma_m >= 0, "surface_sigma_m must be >= 0", p.surface_sigma_m);
   need(p.curve_points >= 2, "curve_points must be >= 2", p.curve_points);
   sectionFractions(p);
 }
@@ -632,7 +633,7 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
     }
     // Fewer even then: five points leave a quadratic two degrees of freedom, and its
     // end slope came out up to 10° off on a clean 8,000-point mainsail.
-    const QuadFit q = win.size() >= kMinEndPoints ? fitQuadratic(win, x_end, 0.0) : QuadFit{};
+    const QuadFit q = win.size() >= kMinEndPoints ? fitQuadratic(win, x_end, p.surface_sigma_m) : QuadFit{};
     if (!q.ok) {
       sd_deg = std::numeric_limits<double>::quiet_NaN();
       warnings.push_back("section " + formatFixed(t, 3) + ": too few points for the " + which + " angle (" +
@@ -645,7 +646,12 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
                          std::to_string(win.size()) + " points over " + formatFixed(100 * window, 0) +
                          " % of the chord (too few within " + formatFixed(100 * p.end_window, 0) + " %)");
     const double slope = at_luff ? q.c[1] : -q.c[1];
-    const double inflate = correlationInflation(win.size(), window * f.chord, p.noise_correlation_m);
+    const double span = window * f.chord;
+    double inflate = correlationInflation(win.size(), span, p.noise_correlation_m);
+    // A window shorter than the noise's correlation length sees the surface's error
+    // as one smooth tilt, whose slope spreads by the error over that length, not
+    // over the window: σ/span would grow without bound on short chords.
+    if (span < p.noise_correlation_m) inflate *= (span / p.noise_correlation_m) * (span / p.noise_correlation_m);
     sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDeg;
     return std::atan(slope) * kDeg;
   };

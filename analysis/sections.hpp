@@ -26,6 +26,11 @@ struct SectionParams {
   // Length over which the curve's noise is correlated (the smoothing radius; 0:
   // independent points). Fit uncertainties count one independent sample per length.
   double noise_correlation_m = 0.0;
+  // 1σ of the (smoothed) surface about the true one: the least residual σ the
+  // entry and exit fits assume. Their cut points follow the smoothed surface, whose
+  // error is smooth over noise_correlation_m and hides in a quadratic's residuals.
+  // 0: the residuals alone. The pipeline sets it from the smoothing.
+  double surface_sigma_m = 0.0;
   int curve_points = 61;              // points of the output curve
   // A hole in the scan (an occlusion by a sheet or spar, a dropout) breaks the
   // section curve. Gaps up to 10 % of the chord are read as they are; inside
