@@ -33,9 +33,14 @@ struct SailOutline {
   double luff_length_m = 0, leech_length_m = 0, foot_length_m = 0, top_length_m = 0;
   double area_m2 = 0;
   double boundary_spacing_m = 0;      // median boundary segment length
-  // 1σ position uncertainty of points on the fitted luff and leech (from the
-  // boundary points' scatter about the fit and the recess estimate), metres.
+  // 1σ position uncertainty across the fitted luff and leech between the corners
+  // (from the boundary points' scatter about the fit and the recess estimate, or
+  // the samples' lower envelope the curve runs on), metres.
   double luff_sigma_m = 0, leech_sigma_m = 0;
+  // 1σ of each corner's place along its bisector (the edges' crossing, narrowed by
+  // how far the samples reach), metres. A section's ends sit at arc fractions from
+  // the corners, so these move them along the luff and leech.
+  double tack_sigma_m = 0, clew_sigma_m = 0, head_sigma_m = 0, peak_sigma_m = 0;
   std::vector<std::string> warnings;
 };
 

@@ -666,11 +666,44 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
   v.exit_deg = endAngle(false, u.exit_deg);
   const double chord_dir_sd = sigma_ends / f.chord;  // rad
   const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
-  u.chord_m = sigma_ends;
+  // The corners' places (each known to its σ along its bisector) move the ends
+  // along the luff and the leech, the sections standing at arc fractions from the
+  // foot (SPEC §5): the luff point by (1 − t) of the tack's shift and t of the
+  // head's, the leech point likewise from the clew and the head (or the peak). A
+  // shared head moves both ends alike, and its share of a change in the chord
+  // (luff point − leech point) cancels as far as the edges run alike. Across the
+  // edges, sigma_ends stands as before.
+  struct CornerShift {
+    double sigma_m, luff_share, leech_share;
+  };
+  const double top_sigma = outline.has_peak ? outline.peak_sigma_m : 0.0;
+  const CornerShift shifts[] = {{outline.tack_sigma_m, 1.0 - t, 0.0},
+                                {outline.clew_sigma_m, 0.0, 1.0 - t},
+                                {outline.head_sigma_m, t, outline.has_peak ? 0.0 : t},
+                                {top_sigma, 0.0, t}};
+  auto tangentAt = [&](const std::vector<Vec3>& line) {
+    constexpr double kStep = 1e-3;  // of the edge's arc
+    const Vec3 d = pointAtFraction(line, std::min(1.0, t + kStep)) - pointAtFraction(line, std::max(0.0, t - kStep));
+    return d.norm() > 0 ? Vec3(d.normalized()) : Vec3::Zero();
+  };
+  const Vec3 luff_tangent = tangentAt(outline.luff), leech_tangent = tangentAt(outline.leech);
+  // 1σ of the chord vector's component along unit d from the corners' places.
+  auto cornerSd = [&](const Vec3& d) {
+    double var = 0;
+    for (const CornerShift& c : shifts)
+      var += std::pow(c.sigma_m * d.dot(c.luff_share * luff_tangent - c.leech_share * leech_tangent), 2);
+    return std::sqrt(var);
+  };
+  u.chord_m = std::hypot(sigma_ends, cornerSd(f.c_hat));
   // The chord line moves by about half the ends' uncertainty at the crest.
   u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.25 * sigma_ends * sigma_ends) / f.chord;
   u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_luff * sigma_luff) / f.chord;
-  u.twist_deg = chord_xy > 0 ? sigma_ends / chord_xy * kDeg : 180.0;
+  if (chord_xy > 0) {
+    const Vec3 across_xy(-(f.R.y() - f.L.y()) / chord_xy, (f.R.x() - f.L.x()) / chord_xy, 0.0);
+    u.twist_deg = std::hypot(sigma_ends, cornerSd(across_xy)) / chord_xy * kDeg;
+  } else {
+    u.twist_deg = 180.0;
+  }
   u.entry_deg = std::hypot(u.entry_deg, chord_dir_sd * kDeg);
   u.exit_deg = std::hypot(u.exit_deg, chord_dir_sd * kDeg);
 
