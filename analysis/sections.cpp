@@ -414,7 +414,8 @@ std::vector<Vec3> resampleCurve(const std::vector<Vec3>& line, int n) {
 }  // namespace
 
 std::vector<std::vector<Vec3>> planeCuts(const Mesh& mesh, const Vec3& point, const Vec3& normal) {
-  if (!(normal.norm() > 0) || !normal.allFinite()) throw InvalidInput("[planeCuts] the plane's normal must be finite and non-zero");
+  if (!(normal.norm() > 0) || !normal.allFinite())
+    throw InvalidInput("[planeCuts] the plane's normal must be finite and non-zero");
   std::vector<std::vector<Vec3>> out;
   for (Cut& c : cutMesh(mesh, vertexNormals(mesh), point, normal.normalized())) out.push_back(std::move(c.points));
   return out;
