@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """A sail generator written apart from analysis/sail_generator: sails built from
 horizontal stripes with a cubic mean line (main, sq = square top, genn =
-gennaker-like), their size, camber, draft, twist and luff sag drawn per seed.
+gennaker-like, jib = headsail on a raked forestay), their size, camber, draft, twist and luff sag drawn per seed.
 Writes OUT_design.ply (the exact surface, 400 x 200 cells: the truth's sections
 come from `sailshape design show` on it), OUT_truth.json (exact corners) and
 OUT.xyz (samples spread uniformly by area, Gaussian noise).
 
-usage: gen.py main|sq|genn SEED POINTS NOISE_MM OUT [ray] [scene] [holes] [scale=S] [lines=M]
+usage: gen.py main|sq|genn|jib SEED POINTS NOISE_MM OUT [ray] [scene] [holes] [scale=S] [lines=M]
   ray      noise along the ray from a scanner position instead of isotropic
   scene    add a mast beside the luff, a boom under the foot and a deck
   holes    cut 2-5 holes (3-6 % of the stripe and chord parameters) out of the samples
@@ -19,7 +19,7 @@ opts = sys.argv[6:]
 scene = 'scene' in opts; ray = 'ray' in opts; holes = 'holes' in opts
 LINES = float([o for o in opts if o.startswith('lines=')][0][6:]) if any(o.startswith('lines=') for o in opts) else 0.0
 SC = float([o for o in opts if o.startswith('scale=')][0][6:]) if any(o.startswith('scale=') for o in opts) else 1.0
-R = random.Random(seed * 7919 + {'main': 1, 'genn': 2, 'sq': 3}[kind])
+R = random.Random(seed * 7919 + {'main': 1, 'genn': 2, 'sq': 3, 'jib': 4}[kind])
 U = lambda a, b: R.uniform(a, b)
 if kind == 'main':
     H = U(7, 14); F = H * U(0.3, 0.45); tack = (U(-0.3, 0.3), 0.0, U(0.4, 1.5)); rake = U(-0.06, 0.02) * H
@@ -31,6 +31,12 @@ elif kind == 'sq':
     sag = U(-0.01, 0.01) * H; ch = F * U(0.25, 0.45)
     cam = (U(0.06, 0.12), U(0.08, 0.15), U(0.06, 0.13)); drf = (U(-0.6, 0.3), U(-0.6, 0.3), U(-0.6, 0.3))
     tw0 = U(2, 10); dtw = U(5, 20); side = R.choice([-1, 1]); rise = U(0.0, 0.15) * F
+elif kind == 'jib':
+    # forestay from the bow raked 14-22 deg aft, sagging to leeward; the clew low or high
+    H = U(8, 14); F = H * U(0.3, 0.6); tack = (U(2.5, 4.5), 0.0, U(0.3, 1.0)); rake = -math.tan(math.radians(U(14, 22))) * H
+    sag = U(0.005, 0.02) * H; ch = 0.0
+    cam = (U(0.08, 0.14), U(0.09, 0.16), U(0.07, 0.14)); drf = (U(-0.5, 0.3), U(-0.5, 0.3), U(-0.5, 0.3))
+    tw0 = U(3, 10); dtw = U(5, 20); side = R.choice([-1, 1]); rise = U(-0.05, 0.25) * F
 else:
     H = U(10, 16); F = H * U(0.45, 0.65); tack = (U(1.0, 3.0), 0.0, U(0.3, 1.0)); rake = U(-0.15, -0.05) * H
     sag = U(0.04, 0.09) * H; ch = 0.0
@@ -143,7 +149,7 @@ with open(out + '.xyz', 'w') as fo:
         # boom: from the mast to past the clew, under the foot
         rb = RS.uniform(0.05, 0.08); cl = point(0, 1)
         b0 = [L0[0] - 0.0, L0[1], L0[2] - rb - RS.uniform(0.05, 0.15)]; b1 = [cl[0] - 0.3, cl[1], b0[2]]
-        if kind != 'genn': cyl(b0, b1, rb, int(dens * math.pi * rb * math.dist(b0, b1)), [view[m] - b0[m] for m in range(3)])
+        if kind in ('main', 'sq'): cyl(b0, b1, rb, int(dens * math.pi * rb * math.dist(b0, b1)), [view[m] - b0[m] for m in range(3)])
         # deck: 8 x 3 m patch at zdeck
         for _ in range(int(dens * 24 * 0.5)):
             q = [RS.uniform(-4, 4) + (L0[0] - F / 2), RS.uniform(-1.5, 1.5), zdeck]
