@@ -55,10 +55,22 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
                {"foot_length_m", o.foot_length_m},
                {"area_m2", o.area_m2},
                {"corner_count", o.has_peak ? 4 : 3}};
+  const SailOutline::Uncertainty& ou = o.uncertainty;
+  nlohmann::json sail_sigma = {{"tack_m", ou.tack_m},
+                               {"clew_m", ou.clew_m},
+                               {"head_m", ou.head_m},
+                               {"luff_length_m", ou.luff_length_m},
+                               {"leech_length_m", ou.leech_length_m},
+                               {"foot_length_m", ou.foot_length_m},
+                               {"area_m2", ou.area_m2}};
   if (o.has_peak) {
     j["sail"]["peak"] = vec(o.peak);
     j["sail"]["top_length_m"] = o.top_length_m;
+    sail_sigma["peak_m"] = ou.peak_m;
+    sail_sigma["top_length_m"] = ou.top_length_m;
   }
+  // 1σ: a corner's as the distance it may lie off, the rest in their own units.
+  j["sail"]["uncertainty"] = std::move(sail_sigma);
   nlohmann::json sections = nlohmann::json::array();
   for (const Section& s : a.sections.sections) sections.push_back(sectionToJson(s));
   j["sections"] = std::move(sections);
@@ -70,7 +82,15 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
                {"lufa_position_pct", l.lufa_position_pct},
                {"lusw_sag_m", l.lusw_sag_m},
                {"lusw_sag_pct", l.lusw_sag_pct},
-               {"lusw_position_pct", l.lusw_position_pct}};
+               {"lusw_position_pct", l.lusw_position_pct},
+               {"uncertainty",
+                {{"luff_chord_m", l.uncertainty.luff_chord_m},
+                 {"lufa_sag_m", l.uncertainty.lufa_sag_m},
+                 {"lufa_sag_pct", l.uncertainty.lufa_sag_pct},
+                 {"lufa_position_pct", l.uncertainty.lufa_position_pct},
+                 {"lusw_sag_m", l.uncertainty.lusw_sag_m},
+                 {"lusw_sag_pct", l.uncertainty.lusw_sag_pct},
+                 {"lusw_position_pct", l.uncertainty.lusw_position_pct}}}};
   nlohmann::json stages = nlohmann::json::array();
   for (const StageReport& s : a.stages)
     stages.push_back({{"name", s.name},

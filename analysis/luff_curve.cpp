@@ -1,6 +1,9 @@
 #include "analysis/luff_curve.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include "analysis/errors.hpp"
 
@@ -20,10 +23,12 @@ LuffCurve measureLuffCurve(const SailOutline& o) {
   Vec3 across = plane_n.cross(a);
   if (across.dot(o.clew - o.tack) > 0) across = -across;
   double best_fa = 0, best_sw = 0;
+  std::vector<std::array<double, 3>> profile;  // along (%), in-plane and out-of-plane offsets (m)
   for (const Vec3& p : o.luff) {
     const Vec3 d = p - o.tack;
     const double along = d.dot(a) / lc.luff_chord_m * 100.0;
     const double fa = d.dot(across), sw = d.dot(plane_n);
+    profile.push_back({along, fa, sw});
     if (std::abs(fa) > std::abs(best_fa)) {
       best_fa = fa;
       lc.lufa_position_pct = along;
@@ -37,6 +42,25 @@ LuffCurve measureLuffCurve(const SailOutline& o) {
   lc.lusw_sag_m = best_sw;
   lc.lufa_sag_pct = 100.0 * best_fa / lc.luff_chord_m;
   lc.lusw_sag_pct = 100.0 * best_sw / lc.luff_chord_m;
+
+  LuffCurve::Uncertainty& u = lc.uncertainty;
+  u.luff_chord_m = o.uncertainty.luff_length_m;
+  const double sag_sigma = std::hypot(o.luff_sigma_m, o.uncertainty.luff_line_m);
+  u.lufa_sag_m = u.lusw_sag_m = sag_sigma;
+  u.lufa_sag_pct = u.lusw_sag_pct = 100.0 * sag_sigma / lc.luff_chord_m;
+  // Where the offset is within its σ of the largest, the largest could lie: its
+  // place spreads over that stretch (uniformly: its length / √12).
+  auto positionSigma = [&](size_t column, double best) {
+    double lo = 100.0, hi = 0.0;
+    for (const auto& q : profile)
+      if (std::abs(q[column]) >= std::abs(best) - sag_sigma) {
+        lo = std::min(lo, q[0]);
+        hi = std::max(hi, q[0]);
+      }
+    return hi > lo ? (hi - lo) / std::sqrt(12.0) : 0.0;
+  };
+  u.lufa_position_pct = positionSigma(1, best_fa);
+  u.lusw_position_pct = positionSigma(2, best_sw);
   return lc;
 }
 

@@ -1220,6 +1220,40 @@ Vec3 ontoSurface(const Vec3& c, const Mesh& mesh, const PointGrid& tree, double 
   return f ? Vec3(c + f->h[0] * f->normal) : c;
 }
 
+// The area between two polylines running the same way (an edge's sampled
+// boundary and its outline): triangles zipped between them by their arc
+// fractions, signed against the first one's orientation so that where they cross
+// (noise) the stretches cancel, and the total taken as it lies.
+double ribbonArea(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  if (a.size() < 2 || b.size() < 2) return 0;
+  auto fractions = [](const std::vector<Vec3>& line) {
+    std::vector<double> f(line.size(), 0.0);
+    for (size_t i = 1; i < line.size(); ++i) f[i] = f[i - 1] + (line[i] - line[i - 1]).norm();
+    for (double& x : f) x /= std::max(f.back(), 1e-12);
+    return f;
+  };
+  const std::vector<double> fa = fractions(a), fb = fractions(b);
+  std::vector<Vec3> pieces;  // twice each triangle's vector area
+  for (size_t i = 0, j = 0; i + 1 < a.size() || j + 1 < b.size();) {
+    if (j + 1 >= b.size() || (i + 1 < a.size() && fa[i + 1] <= fb[j + 1])) {
+      pieces.push_back((a[i + 1] - a[i]).cross(b[j] - a[i]));
+      ++i;
+    } else {
+      pieces.push_back((b[j + 1] - a[i]).cross(b[j] - a[i]));
+      ++j;
+    }
+  }
+  // A narrow strip's vector area is its area along the surface's normal there; on a
+  // curved sail the normal turns along the edge, so the pieces are summed by size,
+  // each signed by how it lies to their sum.
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& c : pieces) sum += c;
+  const Vec3 ref = sum.norm() > 0 ? Vec3(sum.normalized()) : Vec3::UnitZ();
+  double area = 0;
+  for (const Vec3& c : pieces) area += 0.5 * std::copysign(c.norm(), c.dot(ref));
+  return std::abs(area);
+}
+
 // The edge from corner to corner: the fitted curve between the excluded ends.
 std::vector<Vec3> edgePolyline(const Edge& e, const Vec3& first, const Vec3& last, double step) {
   std::vector<Vec3> out{first};
@@ -1420,25 +1454,41 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
                              ? sample_density_per_m2
                              : static_cast<double>(mesh.vertices.size()) / std::max(1e-12, mesh_area);
   const double reach = std::max(0.05 * total, 10.0 * sp);
-  auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start, double& sigma_m) {
-    const PlacedCorner c =
-        placeCorner(meetEdges(a, a_start, b, b_start, sp, samples), mesh, tree, loose_points, density, reach, sp);
-    sigma_m = c.sigma_m;
-    return ontoSurface(c.point, mesh, tree, sp);
-  };
-  out.tack = corner(luff, true, foot, true, out.tack_sigma_m);
-  out.clew = corner(foot, false, leech, true, out.clew_sigma_m);
-  if (out.has_peak) {
-    out.head = corner(luff, false, top, true, out.head_sigma_m);
-    out.peak = corner(leech, false, top, false, out.peak_sigma_m);
-  } else {
-    out.head = corner(luff, false, leech, false, out.head_sigma_m);
-  }
   // An edge beside scan lines lies anywhere up to a line spacing beyond the last
   // line (uniform: σ = spacing / √12), whatever its fit's own scatter.
   auto reported = [](const Edge& e) { return std::hypot(e.section_sigma, e.line_spacing / std::sqrt(12.0)); };
   out.luff_sigma_m = reported(luff);
   out.leech_sigma_m = reported(leech);
+  out.foot_sigma_m = reported(foot);
+  if (out.has_peak) out.top_sigma_m = reported(top);
+  // Each corner's half angle between its edges (for how its shifts move lengths).
+  struct CornerSpread {
+    double along_m = 0, across_m = 0, half_rad = 0;  // σ along and across the bisector
+    // σ across one of its edges: the bisector leaves each edge at the half angle.
+    double acrossEdge() const { return std::hypot(along_m * std::sin(half_rad), across_m * std::cos(half_rad)); }
+  };
+  auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start, double& sigma_m, double& position_sigma_m,
+                    CornerSpread& spread) {
+    const Meeting m = meetEdges(a, a_start, b, b_start, sp, samples);
+    const PlacedCorner c = placeCorner(m, mesh, tree, loose_points, density, reach, sp);
+    sigma_m = c.sigma_m;
+    // Moving the two edges sideways by ε_a and ε_b moves their crossing across the
+    // bisector by (ε_a − ε_b) / (2 cos(angle / 2)).
+    const double across = std::hypot(m.side_a_m, m.side_b_m) / (2.0 * std::cos(std::min(0.5 * m.angle_rad, 1.4)));
+    spread = {c.sigma_m, across, 0.5 * m.angle_rad};
+    position_sigma_m = std::hypot(c.sigma_m, across);
+    return ontoSurface(c.point, mesh, tree, sp);
+  };
+  CornerSpread at_tack, at_clew, at_head, at_peak;
+  SailOutline::Uncertainty& u = out.uncertainty;
+  out.tack = corner(luff, true, foot, true, out.tack_sigma_m, u.tack_m, at_tack);
+  out.clew = corner(foot, false, leech, true, out.clew_sigma_m, u.clew_m, at_clew);
+  if (out.has_peak) {
+    out.head = corner(luff, false, top, true, out.head_sigma_m, u.head_m, at_head);
+    out.peak = corner(leech, false, top, false, out.peak_sigma_m, u.peak_m, at_peak);
+  } else {
+    out.head = corner(luff, false, leech, false, out.head_sigma_m, u.head_m, at_head);
+  }
   for (const auto& [name, e] : {std::pair<const char*, const Edge*>{"luff", &luff}, {"leech", &leech}, {"foot", &foot},
                                 {"top edge", &top}})
     if (e->line_spacing > 0)
@@ -1456,9 +1506,27 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   out.leech_length_m = polylineLength(out.leech);
   out.foot_length_m = polylineLength(out.foot);
   out.top_length_m = polylineLength(out.top);
-  double area_outside = luff.recess * out.luff_length_m + foot.recess * out.foot_length_m +
-                        leech.recess * out.leech_length_m + top.recess * out.top_length_m;
+  // The sail beyond the mesh: between each edge's sampled boundary and its outline,
+  // corners included (a wide corner's boundary rounds off over half a metre, which
+  // the edges' recess times their lengths left out: clean gennakers' areas came out
+  // 0.03-0.06 m² short).
+  double area_outside = ribbonArea(edge(tack, head), out.luff) + ribbonArea(edge(tack, clew), out.foot) +
+                        ribbonArea(edge(clew, out.has_peak ? peak : head), out.leech);
+  if (out.has_peak) area_outside += ribbonArea(edge(head, peak), out.top);
   out.area_m2 = mesh_area + area_outside;
+  // A corner's shift along its bisector moves each of its edges' ends along the
+  // edge by cos(half angle) of it; an edge's shift across moves the area by its
+  // length (the edges' σ are mostly their common offset, so taken whole).
+  auto lengthSigma = [](const CornerSpread& from, const CornerSpread& to) {
+    return std::hypot(from.along_m * std::cos(from.half_rad), to.along_m * std::cos(to.half_rad));
+  };
+  u.luff_length_m = lengthSigma(at_tack, at_head);
+  u.foot_length_m = lengthSigma(at_tack, at_clew);
+  u.leech_length_m = lengthSigma(at_clew, out.has_peak ? at_peak : at_head);
+  if (out.has_peak) u.top_length_m = lengthSigma(at_head, at_peak);
+  u.luff_line_m = 0.5 * std::hypot(at_tack.acrossEdge(), at_head.acrossEdge());
+  u.area_m2 = std::sqrt(std::pow(out.luff_sigma_m * out.luff_length_m, 2) + std::pow(out.leech_sigma_m * out.leech_length_m, 2) +
+                        std::pow(out.foot_sigma_m * out.foot_length_m, 2) + std::pow(out.top_sigma_m * out.top_length_m, 2));
 
   if (!p.design_lengths_m.empty()) {
     const char* names[3] = {"luff", "leech", "foot"};

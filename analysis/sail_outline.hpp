@@ -41,6 +41,18 @@ struct SailOutline {
   // how far the samples reach), metres. A section's ends sit at arc fractions from
   // the corners, so these move them along the luff and leech.
   double tack_sigma_m = 0, clew_sigma_m = 0, head_sigma_m = 0, peak_sigma_m = 0;
+  // The same across the foot and the top edge.
+  double foot_sigma_m = 0, top_sigma_m = 0;
+  // 1σ of what the outline reports, from the corners' and edges' σ above: each
+  // corner's position (along its bisector, and across it as its two edges move
+  // sideways), each edge's length (its corners' shifts along it) and the area (the
+  // edges' shifts across their lengths).
+  struct Uncertainty {
+    double tack_m = 0, clew_m = 0, head_m = 0, peak_m = 0;
+    double luff_length_m = 0, leech_length_m = 0, foot_length_m = 0, top_length_m = 0;
+    double area_m2 = 0;
+    double luff_line_m = 0;  // the tack-head line at mid-luff, across the luff (the luff curve's sags are measured from it)
+  } uncertainty;
   std::vector<std::string> warnings;
 };
 

@@ -29,21 +29,25 @@ struct AnalyzeOptions {
 
 void printTable(const SailAnalysis& a) {
   const SailOutline& o = a.outline;
-  std::printf("Sail: %zu of %zu points, %zu triangles, area %.2f m2\n", a.sail_points, a.points_in,
-              a.mesh.triangles.size(), o.area_m2);
+  const SailOutline::Uncertainty& u = o.uncertainty;
+  std::printf("Sail: %zu of %zu points, %zu triangles, area %.2f ± %.2f m2\n", a.sail_points, a.points_in,
+              a.mesh.triangles.size(), o.area_m2, u.area_m2);
   if (a.working_voxel_m > 0)
     std::printf("  analysed as %zu points, one per %.1f cm column of the sail (working_voxel_sigmas)\n", a.working_points, 100 * a.working_voxel_m);
-  auto corner = [](const char* name, const Vec3& p) {
-    std::printf("  %-5s (%8.3f, %8.3f, %8.3f) m\n", name, p.x(), p.y(), p.z());
+  auto corner = [](const char* name, const Vec3& p, double sigma_m) {
+    std::printf("  %-5s (%8.3f, %8.3f, %8.3f) m ± %.1f cm\n", name, p.x(), p.y(), p.z(), 100 * sigma_m);
   };
-  corner("tack", o.tack);
-  corner("clew", o.clew);
-  corner("head", o.head);
-  if (o.has_peak) corner("peak", o.peak);
-  std::printf("  luff %.3f m, leech %.3f m, foot %.3f m", o.luff_length_m, o.leech_length_m, o.foot_length_m);
-  if (o.has_peak) std::printf(", top %.3f m", o.top_length_m);
-  std::printf("\n  luff curve: LUFA sag %.1f mm at %.0f %%, LUSW sag %.1f mm at %.0f %%\n\n", 1000 * a.luff.lufa_sag_m,
-              a.luff.lufa_position_pct, 1000 * a.luff.lusw_sag_m, a.luff.lusw_position_pct);
+  corner("tack", o.tack, u.tack_m);
+  corner("clew", o.clew, u.clew_m);
+  corner("head", o.head, u.head_m);
+  if (o.has_peak) corner("peak", o.peak, u.peak_m);
+  std::printf("  luff %.3f ± %.3f m, leech %.3f ± %.3f m, foot %.3f ± %.3f m", o.luff_length_m, u.luff_length_m,
+              o.leech_length_m, u.leech_length_m, o.foot_length_m, u.foot_length_m);
+  if (o.has_peak) std::printf(", top %.3f ± %.3f m", o.top_length_m, u.top_length_m);
+  const LuffCurve& l = a.luff;
+  std::printf("\n  luff curve: LUFA sag %.1f ± %.1f mm at %.0f ± %.0f %%, LUSW sag %.1f ± %.1f mm at %.0f ± %.0f %%\n\n",
+              1000 * l.lufa_sag_m, 1000 * l.uncertainty.lufa_sag_m, l.lufa_position_pct, l.uncertainty.lufa_position_pct,
+              1000 * l.lusw_sag_m, 1000 * l.uncertainty.lusw_sag_m, l.lusw_position_pct, l.uncertainty.lusw_position_pct);
   std::printf("%8s %9s %14s %14s %14s %14s %13s %13s\n", "height", "chord m", "camber %", "draft %", "twist deg",
               "twist rel", "entry deg", "exit deg");
   // Measured and unmeasured sections in height order.

@@ -4,11 +4,13 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
 #include <tuple>
 
 #include "analysis/analysis_json.hpp"
 #include "analysis/errors.hpp"
+#include "analysis/luff_curve.hpp"
 #include "analysis/mesh.hpp"
 #include "analysis/pipeline.hpp"
 #include "analysis/sail_generator.hpp"
@@ -480,6 +482,55 @@ TEST(Pipeline, TheDraftsUncertaintyCarriesTheCrestFitsBias) {
   }
   EXPECT_LT(std::sqrt(z2 / n), 1.5);
   EXPECT_GT(std::sqrt(z2 / n), 0.25);
+}
+
+TEST(Pipeline, OutlineAndLuffCurveUncertaintiesMatchTheirErrors) {
+  // The corners, the edges' lengths, the area and the luff curve's sags each carry
+  // a σ from the corners' and edges' own. Over 6 seeds of the example gennaker,
+  // clean and under 4 mm of noise, z = error/σ (a corner's distance over its σ)
+  // must stay under 2 RMS (an exact σ gives 1; the truth's lengths are the design
+  // mesh's polylines, themselves a little short of the surface) and over 0.25.
+  const SailDesign design = exampleDesign(SailType::Gennaker);
+  const SailSurface truth(design);
+  SailOutline true_outline;
+  for (int i = 0; i <= 2000; ++i) {
+    const double f = i / 2000.0;
+    true_outline.luff.push_back(truth.luffPoint(f));
+    true_outline.leech.push_back(truth.leechPoint(f));
+    true_outline.foot.push_back(truth.at(0.0, f));
+  }
+  true_outline.tack = truth.tack();
+  true_outline.clew = truth.clew();
+  true_outline.head = truth.head();
+  const LuffCurve true_luff = measureLuffCurve(true_outline);
+  const double true_area = meshArea(generateSailMesh(design, 400, 200));
+  for (double noise : {0.0, 0.004}) {
+    std::map<std::string, std::pair<double, int>> z2;
+    auto add = [&](const std::string& name, double error, double sigma) {
+      ASSERT_GT(sigma, 0) << name;
+      z2[name].first += std::pow(error / sigma, 2);
+      ++z2[name].second;
+    };
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+      const SailAnalysis a = analyzeSail(sampleSail(design, scan(40000, seed, noise)));
+      const SailOutline& o = a.outline;
+      const SailOutline::Uncertainty& u = o.uncertainty;
+      add("corner", (o.tack - truth.tack()).norm(), u.tack_m);
+      add("corner", (o.clew - truth.clew()).norm(), u.clew_m);
+      add("corner", (o.head - truth.head()).norm(), u.head_m);
+      add("length", o.luff_length_m - polylineLength(true_outline.luff), u.luff_length_m);
+      add("length", o.leech_length_m - polylineLength(true_outline.leech), u.leech_length_m);
+      add("length", o.foot_length_m - polylineLength(true_outline.foot), u.foot_length_m);
+      add("area", o.area_m2 - true_area, u.area_m2);
+      add("lufa", a.luff.lufa_sag_m - true_luff.lufa_sag_m, a.luff.uncertainty.lufa_sag_m);
+      add("lusw", a.luff.lusw_sag_m - true_luff.lusw_sag_m, a.luff.uncertainty.lusw_sag_m);
+    }
+    for (const auto& [name, sum] : z2) {
+      const double z_rms = std::sqrt(sum.first / sum.second);
+      EXPECT_LT(z_rms, 2.0) << name << ", noise " << noise;
+      EXPECT_GT(z_rms, 0.25) << name << ", noise " << noise;
+    }
+  }
 }
 
 TEST(Pipeline, NoisyJibMeetsTheTargetsWithItsTackOnTheSurface) {
