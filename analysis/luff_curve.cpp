@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "analysis/errors.hpp"
@@ -51,7 +52,7 @@ LuffCurve measureLuffCurve(const SailOutline& o) {
   // Where the offset is within its σ of the largest, the largest could lie: its
   // place spreads over that stretch (uniformly: its length / √12).
   auto positionSigma = [&](size_t column, double best) {
-    double lo = 100.0, hi = 0.0;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const auto& q : profile)
       if (std::abs(q[column]) >= std::abs(best) - sag_sigma) {
         lo = std::min(lo, q[0]);
