@@ -1221,10 +1221,11 @@ Vec3 ontoSurface(const Vec3& c, const Mesh& mesh, const PointGrid& tree, double 
 }
 
 // The area between two polylines running the same way (an edge's sampled
-// boundary and its outline): triangles zipped between them by their arc
-// fractions, signed against the first one's orientation so that where they cross
-// (noise) the stretches cancel, and the total taken as it lies.
-double ribbonArea(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+// boundary `a` and its outline `b`): triangles zipped between them by their arc
+// fractions, each counted outwards where `b` lies to the right of `a` seen from
+// `up` (outside the sail, for a boundary running anticlockwise about `up`) and
+// inwards where to the left (noise across an edge leaves samples beyond it).
+double ribbonArea(const std::vector<Vec3>& a, const std::vector<Vec3>& b, const Vec3& up) {
   if (a.size() < 2 || b.size() < 2) return 0;
   auto fractions = [](const std::vector<Vec3>& line) {
     std::vector<double> f(line.size(), 0.0);
@@ -1233,25 +1234,20 @@ double ribbonArea(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
     return f;
   };
   const std::vector<double> fa = fractions(a), fb = fractions(b);
-  std::vector<Vec3> pieces;  // twice each triangle's vector area
+  double area = 0;
   for (size_t i = 0, j = 0; i + 1 < a.size() || j + 1 < b.size();) {
+    // Twice the triangle's vector area: it points against `up` when b lies to the right.
+    Vec3 c;
     if (j + 1 >= b.size() || (i + 1 < a.size() && fa[i + 1] <= fb[j + 1])) {
-      pieces.push_back((a[i + 1] - a[i]).cross(b[j] - a[i]));
+      c = (a[i + 1] - a[i]).cross(b[j] - a[i]);
       ++i;
     } else {
-      pieces.push_back((b[j + 1] - a[i]).cross(b[j] - a[i]));
+      c = (b[j + 1] - a[i]).cross(b[j] - a[i]);
       ++j;
     }
+    area -= 0.5 * std::copysign(c.norm(), c.dot(up));
   }
-  // A narrow strip's vector area is its area along the surface's normal there; on a
-  // curved sail the normal turns along the edge, so the pieces are summed by size,
-  // each signed by how it lies to their sum.
-  Vec3 sum = Vec3::Zero();
-  for (const Vec3& c : pieces) sum += c;
-  const Vec3 ref = sum.norm() > 0 ? Vec3(sum.normalized()) : Vec3::UnitZ();
-  double area = 0;
-  for (const Vec3& c : pieces) area += 0.5 * std::copysign(c.norm(), c.dot(ref));
-  return std::abs(area);
+  return area;
 }
 
 // The edge from corner to corner: the fitted curve between the excluded ends.
@@ -1510,9 +1506,16 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   // corners included (a wide corner's boundary rounds off over half a metre, which
   // the edges' recess times their lengths left out: clean gennakers' areas came out
   // 0.03-0.06 m² short).
-  double area_outside = ribbonArea(edge(tack, head), out.luff) + ribbonArea(edge(tack, clew), out.foot) +
-                        ribbonArea(edge(clew, out.has_peak ? peak : head), out.leech);
-  if (out.has_peak) area_outside += ribbonArea(edge(head, peak), out.top);
+  // Seen from `up` each sampled edge runs anticlockwise (as the loop does about its
+  // normal) when it follows the loop's order, clockwise when it runs against it.
+  auto strip = [&](size_t from, size_t to, const std::vector<Vec3>& outline) {
+    const std::vector<Vec3> sampled = edge(from, to);
+    const bool with_loop = sampled.size() > 1 && sampled[1] == pts[(from + 1) % n];
+    return ribbonArea(sampled, outline, with_loop ? loop_normal : Vec3(-loop_normal));
+  };
+  double area_outside = strip(tack, head, out.luff) + strip(tack, clew, out.foot) +
+                        strip(clew, out.has_peak ? peak : head, out.leech);
+  if (out.has_peak) area_outside += strip(head, peak, out.top);
   out.area_m2 = mesh_area + area_outside;
   // A corner's shift along its bisector moves each of its edges' ends along the
   // edge by cos(half angle) of it; an edge's shift across moves the area by its
