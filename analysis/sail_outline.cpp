@@ -573,9 +573,10 @@ void fitEdge(Edge& e, const Samples& smp, double spacing) {
     // windows' own σ beyond their curve. Noise pulls it out all along; a stretch of
     // the edge where the outermost samples fell unluckily deep pulls the windows'
     // curve in there only, which is no reason to leave the envelope (a clean jib's
-    // leech bare for half a metre below the head lost it on the mean). Mains and gennakers with 4 mm of range noise had their leeches
-    // 1.5-2.9 mm out on the envelope, clean ones -1.5 to +0.7 mm. The corner
-    // curves keep the windows' points: near a corner the envelope rests on few samples.
+    // leech bare for half a metre below the head lost it on the mean). Mains and
+    // gennakers with 4 mm of range noise had their leeches 1.5-2.9 mm out on the
+    // envelope, clean ones -1.5 to +0.7 mm. The corner curves keep the windows'
+    // points: near a corner the envelope rests on few samples.
     if (e.line_spacing == 0) {
       std::vector<std::pair<double, double>> beside = stripSamples(
           every_other, [&](size_t i) { return e.curve.at(e.s[i]); }, [&](size_t i) { return e.curve.tangent(e.s[i]); },
@@ -985,8 +986,10 @@ double turnOverWindow(const CornerCurve& c, double window) {
 // window 1.6 cm inside and its quadratic 2.6 cm inside at the head, which came out
 // 5.2 cm low; on the envelope, 0.7 cm. Clean heads, RMS over 20-30 seeds at 40,000
 // points: jibs on a raked forestay 1.86 → 0.86 cm, gennakers 1.20 → 0.99 cm
-// (bench/independent-sails). Wider ones (a tack, a clew, a square head) let their curves
-// shorten where an edge bends; then, if neither edge turns more than 0.08 rad
+// (bench/independent-sails).
+//
+// Wider corners (a tack, a clew, a square head) let their curves shorten where an
+// edge bends; then, if neither edge turns more than 0.08 rad
 // over a frontier window, both move onto the frontier too, with windows from the
 // corner itself over the unshortened reach. The boundary rounds off a wide corner
 // over half a metre and more: a gennaker's foot lay 2-5 cm inside its clew there,
@@ -1457,34 +1460,41 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   out.leech_sigma_m = reported(leech);
   out.foot_sigma_m = reported(foot);
   if (out.has_peak) out.top_sigma_m = reported(top);
-  // Each corner's half angle between its edges (for how its shifts move lengths).
+  // How well a corner is placed: 1σ along and across its bisector, and the half
+  // angle between its edges (how its shifts move the edges' lengths and lines).
   struct CornerSpread {
-    double along_m = 0, across_m = 0, half_rad = 0;  // σ along and across the bisector
+    double along_m = 0, across_m = 0, half_rad = 0;
+    double position() const { return std::hypot(along_m, across_m); }
     // σ across one of its edges: the bisector leaves each edge at the half angle.
     double acrossEdge() const { return std::hypot(along_m * std::sin(half_rad), across_m * std::cos(half_rad)); }
   };
-  auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start, double& sigma_m, double& position_sigma_m,
-                    CornerSpread& spread) {
+  auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start, CornerSpread& spread) {
     const Meeting m = meetEdges(a, a_start, b, b_start, sp, samples);
     const PlacedCorner c = placeCorner(m, mesh, tree, loose_points, density, reach, sp);
-    sigma_m = c.sigma_m;
     // Moving the two edges sideways by ε_a and ε_b moves their crossing across the
     // bisector by (ε_a − ε_b) / (2 cos(angle / 2)).
     const double across = std::hypot(m.side_a_m, m.side_b_m) / (2.0 * std::cos(std::min(0.5 * m.angle_rad, 1.4)));
     spread = {c.sigma_m, across, 0.5 * m.angle_rad};
-    position_sigma_m = std::hypot(c.sigma_m, across);
     return ontoSurface(c.point, mesh, tree, sp);
   };
   CornerSpread at_tack, at_clew, at_head, at_peak;
-  SailOutline::Uncertainty& u = out.uncertainty;
-  out.tack = corner(luff, true, foot, true, out.tack_sigma_m, u.tack_m, at_tack);
-  out.clew = corner(foot, false, leech, true, out.clew_sigma_m, u.clew_m, at_clew);
+  out.tack = corner(luff, true, foot, true, at_tack);
+  out.clew = corner(foot, false, leech, true, at_clew);
   if (out.has_peak) {
-    out.head = corner(luff, false, top, true, out.head_sigma_m, u.head_m, at_head);
-    out.peak = corner(leech, false, top, false, out.peak_sigma_m, u.peak_m, at_peak);
+    out.head = corner(luff, false, top, true, at_head);
+    out.peak = corner(leech, false, top, false, at_peak);
   } else {
-    out.head = corner(luff, false, leech, false, out.head_sigma_m, u.head_m, at_head);
+    out.head = corner(luff, false, leech, false, at_head);
   }
+  out.tack_sigma_m = at_tack.along_m;
+  out.clew_sigma_m = at_clew.along_m;
+  out.head_sigma_m = at_head.along_m;
+  out.peak_sigma_m = at_peak.along_m;
+  SailOutline::Uncertainty& u = out.uncertainty;
+  u.tack_m = at_tack.position();
+  u.clew_m = at_clew.position();
+  u.head_m = at_head.position();
+  u.peak_m = at_peak.position();
   for (const auto& [name, e] : {std::pair<const char*, const Edge*>{"luff", &luff}, {"leech", &leech}, {"foot", &foot},
                                 {"top edge", &top}})
     if (e->line_spacing > 0)
