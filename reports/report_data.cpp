@@ -4,6 +4,8 @@
 #include <limits>
 #include <set>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/errors.hpp"
 #include "database/catalog.hpp"
 #include "database/cloud_blob.hpp"
@@ -45,6 +47,40 @@ void loadContext(Database& db, int64_t trim_step_id, ReportData& data) {
   data.version = textOr(s, 12);
   if (!s.isNull(13)) data.design_mesh = unpackMesh(s.columnBlob(13));
   data.test = textOr(s, 14);
+}
+
+// The outline stored with an analysis: `sail` as `sailshape analyze --json` writes
+// it, with its `luff` object inside (database/import.cpp). A value missing or not a
+// number stays NaN; the stored text not being JSON is a damaged file.
+ReportOutline parseOutline(const std::string& text, int64_t analysis_id, const char* function) {
+  ReportOutline o;
+  if (text.empty()) return o;
+  const nlohmann::json sail = nlohmann::json::parse(text, nullptr, false);
+  if (sail.is_discarded() || !sail.is_object())
+    throw InvalidInput(std::string("[") + function + "] analysis " + std::to_string(analysis_id) +
+                       ": its stored outline (analyses.sail) is not a JSON object");
+  auto read = [](const nlohmann::json& j, const char* key, OutlineMeasure& m) {
+    auto number = [&](const nlohmann::json& from) {
+      auto it = from.find(key);
+      return it != from.end() && it->is_number() ? it->get<double>() : kNaN;
+    };
+    m.value = number(j);
+    auto u = j.find("uncertainty");
+    if (u != j.end() && u->is_object()) m.sigma = number(*u);
+  };
+  read(sail, "luff_length_m", o.luff_length_m);
+  read(sail, "leech_length_m", o.leech_length_m);
+  read(sail, "foot_length_m", o.foot_length_m);
+  read(sail, "top_length_m", o.top_length_m);
+  read(sail, "area_m2", o.area_m2);
+  auto luff = sail.find("luff");
+  if (luff != sail.end() && luff->is_object()) {
+    read(*luff, "lufa_sag_pct", o.lufa_sag_pct);
+    read(*luff, "lufa_position_pct", o.lufa_position_pct);
+    read(*luff, "lusw_sag_pct", o.lusw_sag_pct);
+    read(*luff, "lusw_position_pct", o.lusw_position_pct);
+  }
+  return o;
 }
 
 ReportStep loadStep(Database& db, int64_t scan_id, const char* function) {
@@ -102,10 +138,28 @@ ReportStep loadStep(Database& db, int64_t scan_id, const char* function) {
   if (step.sections.empty())
     throw InvalidInput(std::string("[") + function + "] scan " + std::to_string(scan_id) + " has an analysis without sections");
   step.unmeasured = unmeasuredSections(db, step.analysis_id);
+  Statement a = db.prepare("SELECT sail FROM analyses WHERE id = ?");
+  a.bind(1, step.analysis_id);
+  if (a.step()) step.outline = parseOutline(textOr(a, 0), step.analysis_id, function);
   return step;
 }
 
 }  // namespace
+
+ReportOutline reportOutline(const SailOutline& o, const LuffCurve& l) {
+  ReportOutline r;
+  const SailOutline::Uncertainty& u = o.uncertainty;
+  r.luff_length_m = {o.luff_length_m, u.luff_length_m};
+  r.leech_length_m = {o.leech_length_m, u.leech_length_m};
+  r.foot_length_m = {o.foot_length_m, u.foot_length_m};
+  if (o.has_peak) r.top_length_m = {o.top_length_m, u.top_length_m};
+  r.area_m2 = {o.area_m2, u.area_m2};
+  r.lufa_sag_pct = {l.lufa_sag_pct, l.uncertainty.lufa_sag_pct};
+  r.lufa_position_pct = {l.lufa_position_pct, l.uncertainty.lufa_position_pct};
+  r.lusw_sag_pct = {l.lusw_sag_pct, l.uncertainty.lusw_sag_pct};
+  r.lusw_position_pct = {l.lusw_position_pct, l.uncertainty.lusw_position_pct};
+  return r;
+}
 
 ReportData loadScanReport(Database& db, int64_t scan_id) {
   ReportData data;

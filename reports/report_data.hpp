@@ -2,12 +2,14 @@
 // What a trim report shows, read from the database: the sail and where it
 // flew, and per trim step its conditions, forces, controls and sections.
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "analysis/cloud.hpp"
+#include "analysis/luff_curve.hpp"
 #include "analysis/mesh.hpp"
 #include "analysis/sections.hpp"
 #include "database/sqlite.hpp"
@@ -23,6 +25,22 @@ struct ReportSection {
   std::vector<Vec3> curve;  // metres, boat frame, luff to leech
 };
 
+// A sail's outline measures with their 1σ: NaN where not stored (an analysis
+// imported without its `sail` object, or from before the outline carried σ), or
+// not measured (`top_length_m` of a sail without a peak).
+struct OutlineMeasure {
+  double value = std::numeric_limits<double>::quiet_NaN(), sigma = std::numeric_limits<double>::quiet_NaN();
+};
+struct ReportOutline {
+  OutlineMeasure luff_length_m, leech_length_m, foot_length_m, top_length_m, area_m2;
+  // The luff curve (SPEC §5): its largest sag in the sail's plane (LUFA) and to
+  // leeward of it (LUSW), as % of the tack-head distance, and where along it.
+  OutlineMeasure lufa_sag_pct, lufa_position_pct, lusw_sag_pct, lusw_position_pct;
+};
+
+// The same measures from an outline and its luff curve as analysed (the design's).
+ReportOutline reportOutline(const SailOutline& outline, const LuffCurve& luff);
+
 struct ReportStep {
   int64_t scan_id = 0, trim_step_id = 0, analysis_id = 0;
   int step_order = 0;
@@ -31,6 +49,7 @@ struct ReportStep {
   std::map<std::string, double> controls;  // control-line settings as stored
   std::vector<ReportSection> sections;     // the latest analysis, by fraction
   std::vector<UnmeasuredSection> unmeasured;  // sections it was asked for but could not measure, with why
+  ReportOutline outline;                   // the latest analysis's (analyses.sail)
   Cloud cloud;                             // the stored cloud; empty when none was stored
 };
 

@@ -360,7 +360,59 @@ void viewsPage(PdfDocument& pdf, Pages& pages, const ReportData& d, const Report
                 8.5f);
 }
 
-void tablePage(PdfDocument& pdf, Pages& pages, const ReportData& d, const ReportStep& step, const StepComparison& c) {
+// The sail's outline, design beside flying: edge lengths, area, and the luff
+// curve's sags (SPEC §5), each ± 1σ; a value not stored shows as "–".
+float outlineTable(PdfDocument& pdf, float y, const ReportOutline& design, const ReportOutline& flying) {
+  const float w = pdf.pageWidth();
+  const float col[] = {kMargin + 4, kMargin + 330, kMargin + 410, kMargin + 500};  // label; right edges of the numbers
+  pdf.rect(kMargin, y - 12, w - 2 * kMargin, 18, kNavy);
+  pdf.text(col[0], y, "Outline", 9, true, {1, 1, 1});
+  const char* heads[] = {"Design", "Flying", "Difference"};
+  for (int k = 0; k < 3; ++k) pdf.text(col[k + 1], y, heads[k], 9, true, {1, 1, 1}, Align::Right);
+  y += 18;
+  struct Row {
+    const char* label;
+    OutlineMeasure ReportOutline::*field;
+    const char* format;
+  };
+  const Row rows[] = {{"Luff length, m", &ReportOutline::luff_length_m, "%.3f"},
+                      {"Leech length, m", &ReportOutline::leech_length_m, "%.3f"},
+                      {"Foot length, m", &ReportOutline::foot_length_m, "%.3f"},
+                      {"Top length (square top), m", &ReportOutline::top_length_m, "%.3f"},
+                      {"Area, m²", &ReportOutline::area_m2, "%.2f"},
+                      {"Luff sag in the sail's plane (LUFA), %", &ReportOutline::lufa_sag_pct, "%.2f"},
+                      {"   its height up the luff, %", &ReportOutline::lufa_position_pct, "%.0f"},
+                      {"Luff sag across it, to port (LUSW), %", &ReportOutline::lusw_sag_pct, "%.2f"},
+                      {"   its height up the luff, %", &ReportOutline::lusw_position_pct, "%.0f"}};
+  auto cell = [](const char* f, double v, double u, bool diff) {
+    if (!std::isfinite(v)) return std::string("–");
+    std::string out = signedFmt(diff ? ("%+" + std::string(f + 1)).c_str() : f, v);
+    if (std::isfinite(u)) out += " ± " + fmt(f, std::abs(u));
+    return out;
+  };
+  int band = 0;
+  for (const Row& r : rows) {
+    const OutlineMeasure &a = design.*r.field, &b = flying.*r.field;
+    if (!std::isfinite(a.value) && !std::isfinite(b.value)) continue;  // e.g. no top edge
+    if (band++ % 2) pdf.rect(kMargin, y - 10, w - 2 * kMargin, 14, kBand);
+    pdf.text(col[0], y, r.label, 8.5f, false, kBlack);
+    pdf.text(col[1], y, cell(r.format, a.value, a.sigma, false), 8.5f, false, kDesignBlue, Align::Right);
+    pdf.text(col[2], y, cell(r.format, b.value, b.sigma, false), 8.5f, false, kFlyingRed, Align::Right);
+    const double du = std::isfinite(a.sigma) || std::isfinite(b.sigma)
+                          ? std::hypot(std::isfinite(a.sigma) ? a.sigma : 0.0, std::isfinite(b.sigma) ? b.sigma : 0.0)
+                          : kNaN;
+    pdf.text(col[3], y, cell(r.format, b.value - a.value, du, true), 8.5f, true, kBlack, Align::Right);
+    y += 14;
+  }
+  y += 4;
+  return pdf.paragraph(kMargin, y, w - 2 * kMargin,
+                       "Sags are the luff's largest offset from the straight line tack to head, as % of that line's "
+                       "length; in the sail's plane + is away from the clew.",
+                       8.5f, false, kGrey);
+}
+
+void tablePage(PdfDocument& pdf, Pages& pages, const ReportData& d, const ReportStep& step, const StepComparison& c,
+               const ReportOutline& design_outline) {
   float y = pages.start("Sections · " + stepLabel(d, step) + " · " + conditions(step));
   const float w = pdf.pageWidth();
   y = pdf.paragraph(kMargin, y, w - 2 * kMargin,
@@ -440,6 +492,7 @@ void tablePage(PdfDocument& pdf, Pages& pages, const ReportData& d, const Report
                       return out;
                     }() + " (flying).",
                     8.5f, false, kGrey);
+  outlineTable(pdf, y + 14, design_outline, step.outline);
 }
 
 std::vector<Series> parameterSeries(const TrimReportData& r, double SectionParameters::*field, bool with_design) {
@@ -749,6 +802,7 @@ TrimReportData prepareTrimReport(const TrimReportParams& p, const Progress& prog
   sp.sensor_sigma_m = 0;  // an exact surface: what is left is the resampling's own scatter
   const MeshSections design = analyzeMeshSections(*r.data.design_mesh, {}, sp, p.design_sampling);
   r.design_sections = design.sections;
+  r.design_outline = reportOutline(design.outline, measureLuffCurve(design.outline));
   r.warnings = design.sections.warnings;
   r.notes = design.notes;
   progress("design", 0.6);
@@ -828,7 +882,7 @@ TrimReport writeTrimReport(const TrimReportParams& p, const Progress& progress) 
     plotsPage(pdf, pages, r, true);
   } else {
     for (size_t i = 0; i < d.steps.size(); ++i) viewsPage(pdf, pages, d, d.steps[i], r.steps[i], views[i], rangeOf(r.steps[i]));
-    for (size_t i = 0; i < d.steps.size(); ++i) tablePage(pdf, pages, d, d.steps[i], r.steps[i]);
+    for (size_t i = 0; i < d.steps.size(); ++i) tablePage(pdf, pages, d, d.steps[i], r.steps[i], r.design_outline);
     plotsPage(pdf, pages, r, false);
     curvesPage(pdf, pages, r);
   }

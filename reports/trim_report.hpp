@@ -49,6 +49,7 @@ struct StepComparison {
 struct TrimReportData {
   ReportData data;
   SectionAnalysis design_sections;  // the design analysed at every fraction any step was cut at
+  ReportOutline design_outline;     // the design's outline and luff curve, from the same analysis
   std::vector<StepComparison> steps;
   Summary summary;                  // of the last step
   std::vector<std::string> warnings;

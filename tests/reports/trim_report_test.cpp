@@ -88,6 +88,19 @@ nlohmann::json flyingSection(const SailSurface& surface, double f, int k) {
   return s;
 }
 
+// Step k's outline as `sailshape analyze --json` stores it: the luff 2 cm longer per
+// step (halyard), the rest as printed by the report (3 and 2 decimals), each with a σ.
+void flyingOutline(nlohmann::json& doc, int k) {
+  doc["sail"] = {{"luff_length_m", 10.012 + 0.02 * k}, {"leech_length_m", 10.481}, {"foot_length_m", 3.597},
+                 {"area_m2", 18.34 - 0.05 * k}};
+  doc["sail"]["uncertainty"] = {{"luff_length_m", 0.004}, {"leech_length_m", 0.005}, {"foot_length_m", 0.003},
+                                {"area_m2", 0.02}};
+  doc["luff"] = {{"lufa_sag_pct", 0.85 + 0.1 * k}, {"lufa_position_pct", 48.0}, {"lusw_sag_pct", -0.31},
+                 {"lusw_position_pct", 55.0}};
+  doc["luff"]["uncertainty"] = {{"lufa_sag_pct", 0.03}, {"lufa_position_pct", 6.0}, {"lusw_sag_pct", 0.04},
+                                {"lusw_position_pct", 9.0}};
+}
+
 struct Fixture {
   TempDir dir;
   std::string db_path = dir.file("trim.sailshape");
@@ -104,6 +117,7 @@ struct Fixture {
       nlohmann::json doc;
       doc["sections"] = nlohmann::json::array();
       for (int i = 1; i <= kSections; ++i) doc["sections"].push_back(flyingSection(surface, i / 9.0, k));
+      flyingOutline(doc, k);
       ImportMetadata meta;
       meta.campaign = kCampaign;
       meta.session = "day 1";
@@ -332,6 +346,93 @@ TEST(TrimReport, DesignerReportShowsTheDatabaseNumbersAndBothColours) {
       }
     }
   }
+}
+
+// The outline block of each step's table page: the stored flying outline, the
+// design's from analysing its mesh, and their difference, each ± 1σ.
+TEST(TrimReport, OutlineShowsStoredFlyingAndAnalysedDesignLengths) {
+  const TrimReportParams p = fixture().params("outline.pdf");
+  const TrimReport report = writeTrimReport(p);
+  const TrimReportData& r = report.content;
+  // The design's edges and area against the generator's exact surface: an 80 × 40
+  // mesh of it follows the edges to well under a millimetre; its corners are found
+  // to a few (tests/analysis/design_compare_test.cpp), which moves a length by as much.
+  const SailSurface exact(fixture().design);
+  auto arc = [&](auto point) {
+    double length = 0;
+    for (int i = 1; i <= 2000; ++i) length += (point(i / 2000.0) - point((i - 1) / 2000.0)).norm();
+    return length;
+  };
+  const double luff = arc([&](double f) { return exact.at(f, 0.0); });
+  const double leech = arc([&](double f) { return exact.at(f, 1.0); });
+  const double foot = arc([&](double u) { return exact.at(0.0, u); });
+  double area = 0;
+  constexpr int kN = 400;
+  for (int i = 0; i < kN; ++i)
+    for (int j = 0; j < kN; ++j) {
+      const double f = (i + 0.5) / kN, u = (j + 0.5) / kN, h = 0.5 / kN;
+      area += ((exact.at(f + h, u) - exact.at(f - h, u)).cross(exact.at(f, u + h) - exact.at(f, u - h))).norm();
+    }
+  EXPECT_NEAR(r.design_outline.luff_length_m.value, luff, 0.005);
+  EXPECT_NEAR(r.design_outline.leech_length_m.value, leech, 0.005);
+  EXPECT_NEAR(r.design_outline.foot_length_m.value, foot, 0.005);
+  EXPECT_NEAR(r.design_outline.area_m2.value, area, 0.02);
+  EXPECT_TRUE(std::isnan(r.design_outline.top_length_m.value));  // a triangular main has no top edge
+  EXPECT_TRUE(std::isfinite(r.design_outline.luff_length_m.sigma));
+
+  const std::string text = pdfText(p.out_path);
+  EXPECT_NE(text.find("Luff length, m"), std::string::npos);
+  EXPECT_EQ(text.find("Top length"), std::string::npos);
+  for (int k = 0; k < kSteps; ++k) {
+    SCOPED_TRACE("step " + std::to_string(k + 1));
+    const nlohmann::json& doc = fixture().docs[k];
+    const ReportOutline& o = r.data.steps[k].outline;
+    EXPECT_DOUBLE_EQ(o.luff_length_m.value, doc["sail"]["luff_length_m"].get<double>());
+    EXPECT_DOUBLE_EQ(o.area_m2.sigma, 0.02);
+    EXPECT_DOUBLE_EQ(o.lufa_sag_pct.value, doc["luff"]["lufa_sag_pct"].get<double>());
+    EXPECT_DOUBLE_EQ(o.lusw_position_pct.sigma, 9.0);
+    const double dl = o.luff_length_m.value - r.design_outline.luff_length_m.value;
+    const double dl_sigma = std::hypot(o.luff_length_m.sigma, r.design_outline.luff_length_m.sigma);
+    EXPECT_NE(text.find(fmt("%.3f", o.luff_length_m.value) + " ± 0.004"), std::string::npos);
+    EXPECT_NE(text.find(fmt("%.2f", o.area_m2.value) + " ± 0.02"), std::string::npos);
+    EXPECT_NE(text.find(fmt("%.2f", o.lufa_sag_pct.value) + " ± 0.03"), std::string::npos);
+    const std::string signed_dl = (dl < 0 ? "−" + fmt("%.3f", -dl) : fmt("%+.3f", dl)) + " ± " + fmt("%.3f", dl_sigma);
+    EXPECT_NE(text.find(signed_dl), std::string::npos) << signed_dl;
+  }
+}
+
+// An analysis stored without its outline (imported from a document with sections
+// only) shows "–" for flying, and the design's values still.
+TEST(TrimReport, AnAnalysisWithoutItsOutlineShowsDashes) {
+  TempDir dir;
+  const std::string db_path = dir.file("no-outline.sailshape");
+  {
+    Database db = openSailDatabase(db_path);
+    const Mesh mesh = generateSailMesh(fixture().design);
+    upsertSail(db, {kSail, "mainsail", "M", "", "", kBoat}, &mesh);
+    nlohmann::json doc = fixture().docs.front();
+    doc.erase("sail");
+    doc.erase("luff");
+    ImportMetadata meta;
+    meta.campaign = kCampaign;
+    meta.session = "day 1";
+    meta.sail = kSail;
+    meta.test = kTest;
+    meta.trim_step = 1;
+    importScan(db, meta, &doc);
+  }
+  TrimReportParams p;
+  p.db_path = db_path;
+  p.test = kTest;
+  p.out_path = dir.file("no-outline.pdf");
+  const TrimReport report = writeTrimReport(p);
+  EXPECT_TRUE(std::isnan(report.content.data.steps.front().outline.luff_length_m.value));
+  const std::string text = pdfText(p.out_path);
+  const size_t at = text.find("Luff length, m");
+  ASSERT_NE(at, std::string::npos);
+  const std::string line = text.substr(at, text.find('\n', at) - at);
+  EXPECT_NE(line.find(fmt("%.3f", report.content.design_outline.luff_length_m.value)), std::string::npos) << line;
+  EXPECT_NE(line.find("–"), std::string::npos) << line;
 }
 
 TEST(TrimReport, CrewReportIsShorterAndInPlainWords) {
