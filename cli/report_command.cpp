@@ -36,11 +36,12 @@ void addReportCommand(CLI::App& app) {
       "Write a PDF trim report of one scan or of a test's trim steps from the database: a cover with boat, sail, "
       "campaign, conditions and units; 3D views of the design (blue grid) and the flying shape (red) from the side, "
       "above and astern with the signed deviation as a colour map in mm; the section table (camber, draft, twist, "
-      "entry, exit: design, flying, difference, each ±1σ); camber, draft and twist against height; each section's "
+      "entry, exit: design, flying, difference, each ±1σ) and the outline table (luff, leech, foot and top lengths, "
+      "area, the luff curve's sags: the same three rows); camber, draft and twist against height; each section's "
       "curve flying over design; for a test, the change of every parameter from step to step beside the measured "
-      "forces; and a plain-words summary of the largest differences. The design's sections come from analysing the "
-      "sail's stored design mesh at the flying sections' heights. Renders offscreen: without DISPLAY a private Xvfb "
-      "is started for the pictures.");
+      "forces; and a plain-words summary of the largest differences. The design's sections and outline come from "
+      "analysing the sail's stored design mesh, its sections at the flying sections' heights. Renders offscreen: "
+      "without DISPLAY a private Xvfb is started for the pictures.");
   cmd->add_option("--db", opt->params.db_path, "The sailshape database (see `sailshape db`); opened read-only")
       ->required();
   auto* scan = cmd->add_option("--scan", opt->scan_id, "Report on this scan (id as listed by `sailshape db list`)")
