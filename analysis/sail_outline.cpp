@@ -1544,6 +1544,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   if (!p.design_lengths_m.empty()) {
     const char* names[3] = {"luff", "leech", "foot"};
     const double measured[3] = {out.luff_length_m, out.leech_length_m, out.foot_length_m};
+    const double sigma[3] = {u.luff_length_m, u.leech_length_m, u.foot_length_m};
     for (int i = 0; i < 3; ++i) {
       const double design = p.design_lengths_m[static_cast<size_t>(i)];
       if (!(design > 0)) continue;
@@ -1552,6 +1553,14 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
         throw AnalysisError(std::string("[extractOutline] ") + names[i] + " length " + formatFixed(measured[i]) + " m is " +
                             formatFixed(100 * off, 1) + " % off the design " + formatFixed(design) + " m (limit " +
                             formatFixed(100 * p.design_tolerance, 0) + " %): corners or segmentation are wrong");
+      if (off > p.design_warning && std::abs(measured[i] - design) > 3.0 * sigma[i])
+        out.warnings.push_back(std::string(names[i]) + " length " + formatFixed(measured[i]) + " m is " +
+                               formatFixed(100 * off, 1) + " % " + (measured[i] < design ? "shorter" : "longer") +
+                               " than the design's " + formatFixed(design) + " m: " +
+                               (measured[i] < design ? "the scan may not reach a corner, or the beam's footprint trims "
+                                                       "a narrow head; "
+                                                     : "the sail cluster may hold more than the sail; ") +
+                               "the sections sit at fractions of the edges as measured");
     }
   }
   return out;

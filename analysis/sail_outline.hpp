@@ -17,9 +17,14 @@ struct OutlineParams {
   double min_fourth_corner_deg = 40;
   double edge_smoothing_m = 0.0;      // moving-average window along the edges; 0: 0.6 % of boundary length
   // Design lengths [luff, leech, foot] in metres to check against (empty: no check);
-  // more than design_tolerance off stops the analysis (SPEC §4 step 6).
+  // more than design_tolerance off stops the analysis (SPEC §4 step 6); more than
+  // design_warning off, and beyond 3σ of the measured length, is a warning: a flying
+  // edge stretches by a percent or two, while a scan that does not reach a corner
+  // (or whose beam footprint trims a narrow head) reads several percent short, and
+  // its sections then sit at fractions of the edges as measured.
   std::vector<double> design_lengths_m;
   double design_tolerance = 0.10;
+  double design_warning = 0.02;
 };
 
 struct SailOutline {

@@ -113,6 +113,39 @@ TEST(SailOutline, ATriangleNamingAMissingVertexIsRejected) {
   expectInvalidInput([&] { extractOutline(m); }, {"[extractOutline]", "vertex 99999", "3321 vertices"});
 }
 
+// SPEC §4 step 6: lengths checked against the design's. The exact design mesh of a
+// main measures its own lengths; told a design luff 5 % longer, it warns (the
+// luff's σ is millimetres), told one 12 % longer, it stops with the exact reason.
+TEST(SailOutline, LengthsAreCheckedAgainstTheDesign) {
+  const Mesh mesh = generateSailMesh(exampleDesign(SailType::Main));
+  const SailOutline own = extractOutline(mesh);
+  OutlineParams p;
+  p.design_lengths_m = {own.luff_length_m, own.leech_length_m, own.foot_length_m};
+  const SailOutline same = extractOutline(mesh, p);
+  for (const std::string& w : same.warnings) EXPECT_EQ(w.find("than the design"), std::string::npos) << w;
+
+  p.design_lengths_m[0] = 1.05 * own.luff_length_m;
+  const SailOutline short_luff = extractOutline(mesh, p);
+  std::vector<std::string> about_luff;
+  for (const std::string& w : short_luff.warnings)
+    if (w.find("than the design") != std::string::npos) about_luff.push_back(w);
+  ASSERT_EQ(about_luff.size(), 1u);
+  EXPECT_EQ(about_luff[0], "luff length " + formatFixed(own.luff_length_m) + " m is 4.8 % shorter than the design's " +
+                               formatFixed(1.05 * own.luff_length_m) +
+                               " m: the scan may not reach a corner, or the beam's footprint trims a narrow head; the "
+                               "sections sit at fractions of the edges as measured");
+
+  p.design_lengths_m[0] = 1.12 * own.luff_length_m;
+  try {
+    extractOutline(mesh, p);
+    FAIL() << "a luff 10.7 % short was accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_EQ(std::string(e.what()), "[extractOutline] luff length " + formatFixed(own.luff_length_m) +
+                                         " m is 10.7 % off the design " + formatFixed(1.12 * own.luff_length_m) +
+                                         " m (limit 10 %): corners or segmentation are wrong");
+  }
+}
+
 TEST(SailOutline, AClosedSurfaceHasNoBoundary) {
   Mesh m;
   m.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
