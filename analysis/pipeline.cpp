@@ -327,7 +327,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
       loose.insert(loose.end(), scan_points.begin(), scan_points.end());
       sample_density = static_cast<double>(a.sail_points) / std::max(1e-12, meshArea(a.mesh));
     }
-    a.outline = extractOutline(a.mesh, p.outline, loose, sample_density);
+    a.outline = extractOutline(a.mesh, p.outline, loose, sample_density, input.viewpoint);
     a.luff = measureLuffCurve(a.outline);
     t.finish(a.outline.boundary.size(), a.outline.warnings);
   }

@@ -247,6 +247,10 @@ double recessFromLeast(double least, double D, double n) {
 // 1/8 of a shorter edge's reach, but no less than a spacing: frontierWindow).
 constexpr double kFrontierStripSpacings = 4.0, kFrontierWindowSpacings = 5.0;
 constexpr double kFrontierFewestWindows = 8.0;
+// How well the beam footprint's reach across an edge is known, as a fraction of it:
+// beam figures vary by unit (SPEC §3), and whether an edge return leaves the sail
+// depends on what lies behind it.
+constexpr double kFootprintUncertainty = 0.25;
 
 // Calls f(a, b) for each run [a, b) of `sorted` (samples (arc position, offset) in
 // ascending arc position) that starts where the last one ended and reaches less than
@@ -1253,6 +1257,23 @@ double ribbonArea(const std::vector<Vec3>& a, const std::vector<Vec3>& b, const 
   return area;
 }
 
+// How far the beam's footprint reaches from its axis across the surface at p
+// (unit normal n) in the surface direction w (unit), for a scanner at `origin`: the
+// beam's radius there, exit/2 + range·divergence/2, and in the plane of incidence
+// that over cos(incidence) (capped at 80°, beyond which nothing returns).
+double footprintReach(const OutlineParams& p, const Vec3& origin, const Vec3& at, const Vec3& n, const Vec3& w) {
+  const Vec3 d = at - origin;
+  const double range = d.norm();
+  if (!(range > 0)) return 0;
+  const double radius = 0.5 * p.beam_exit_diameter_m + 0.5 * range * p.beam_divergence_rad;
+  const Vec3 ray = d / range;
+  const double cos_i = std::max(std::abs(ray.dot(n)), std::cos(80.0 * kPi / 180.0));
+  const Vec3 along = ray - ray.dot(n) * n;  // the ray's direction in the surface
+  const double c = along.norm() > 1e-9 ? w.dot(along.normalized()) : 0.0;
+  const double tan2 = (1.0 - cos_i * cos_i) / (cos_i * cos_i);
+  return radius * std::sqrt(1.0 + tan2 * c * c);
+}
+
 // The edge from corner to corner: the fitted curve between the excluded ends.
 std::vector<Vec3> edgePolyline(const Edge& e, const Vec3& first, const Vec3& last, double step) {
   std::vector<Vec3> out{first};
@@ -1286,14 +1307,23 @@ Vec3 pointAtFraction(const std::vector<Vec3>& line, double fraction) {
 }
 
 SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::vector<Vec3>& loose_points,
-                           double sample_density_per_m2) {
+                           double sample_density_per_m2, const std::optional<Vec3>& scanner) {
   if (mesh.triangles.empty()) throw InvalidInput("[extractOutline] empty mesh");
+  if (!(p.beam_exit_diameter_m >= 0) || !(p.beam_divergence_rad >= 0) || p.beam_exit_diameter_m > 1 ||
+      p.beam_divergence_rad > 0.5)
+    throw InvalidInput("[extractOutline] beam_exit_diameter_m must be in [0, 1] and beam_divergence_rad in [0, 0.5] (got " +
+                       formatFixed(p.beam_exit_diameter_m, 4) + ", " + formatFixed(p.beam_divergence_rad, 4) + ")");
+  const bool beam_given = p.beam_exit_diameter_m > 0 || p.beam_divergence_rad > 0;
+  const bool footprint = beam_given && scanner.has_value();
   if (p.corners != 0 && p.corners != 3 && p.corners != 4)
     throw InvalidInput("[extractOutline] corners must be 0 (auto), 3 or 4 (got " + std::to_string(p.corners) + ")");
   if (!p.design_lengths_m.empty() && p.design_lengths_m.size() != 3)
     throw InvalidInput("[extractOutline] design_lengths_m must be [luff, leech, foot] (got " +
                        std::to_string(p.design_lengths_m.size()) + " values)");
   SailOutline out;
+  if (beam_given && !scanner)
+    out.warnings.push_back("the beam's footprint is given but not where the scanner stood (the cloud has no viewpoint): "
+                           "the edges are not moved out by it");
   const std::vector<uint32_t> loop_idx = outerBoundaryLoop(mesh);
   std::vector<Vec3>& pts = out.boundary;
   for (uint32_t v : loop_idx) pts.push_back(mesh.vertices[v]);
@@ -1474,8 +1504,34 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
     // Moving the two edges sideways by ε_a and ε_b moves their crossing across the
     // bisector by (ε_a − ε_b) / (2 cos(angle / 2)).
     const double across = std::hypot(m.side_a_m, m.side_b_m) / (2.0 * std::cos(std::min(0.5 * m.angle_rad, 1.4)));
-    spread = {c.sigma_m, across, 0.5 * m.angle_rad};
-    return ontoSurface(c.point, mesh, tree, sp);
+    // Each edge out by the beam's footprint: the corner moves by x with x·(−in_a) =
+    // s_a and x·(−in_b) = s_b, in the corner's plane (far along the bisector at a
+    // narrow head: a footprint of 1.5 cm moved a 20° head of a tunnel main 9 cm).
+    Vec3 point = c.point;
+    double footprint_sigma = 0;
+    if (footprint) {
+      // The edges' directions over a tenth of their length: the corner curves' own
+      // tangents where they meet, extrapolated past the samples, may close in (a
+      // tunnel main's 20° head met at 3.7°, which moved it 67 cm).
+      auto chord = [&](const Edge& e, bool at_start) {
+        const double l = std::clamp(0.1 * e.length, std::min(e.exclude + sp, 0.5 * e.length), 0.5 * e.length);
+        return Vec3(e.curve.at(at_start ? l : e.length - l) - point).normalized();
+      };
+      const Vec3 ta = chord(a, a_start), tb = chord(b, b_start);
+      const Vec3 across_a = tb - tb.dot(ta) * ta, across_b = ta - ta.dot(tb) * tb;
+      const Vec3 plane_normal = ta.cross(tb);
+      if (plane_normal.norm() > 1e-3 && across_a.norm() > 1e-6 && across_b.norm() > 1e-6) {
+        const Vec3 n = plane_normal.normalized(), in_a = across_a.normalized(), in_b = across_b.normalized();
+        const double s_a = footprintReach(p, *scanner, point, n, -in_a);
+        const double s_b = footprintReach(p, *scanner, point, n, -in_b);
+        const double cc = in_a.dot(in_b), det = std::max(1.0 - cc * cc, 1e-6);
+        const Vec3 x = ((-s_a + cc * s_b) * in_a + (-s_b + cc * s_a) * in_b) / det;
+        point += x;
+        footprint_sigma = kFootprintUncertainty * x.norm();
+      }
+    }
+    spread = {std::hypot(c.sigma_m, footprint_sigma), across, 0.5 * m.angle_rad};
+    return ontoSurface(point, mesh, tree, sp);
   };
   CornerSpread at_tack, at_clew, at_head, at_peak;
   out.tack = corner(luff, true, foot, true, at_tack);
@@ -1508,6 +1564,33 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   out.foot = edgePolyline(foot, out.tack, out.clew, sp);
   out.leech = edgePolyline(leech, out.clew, out.has_peak ? out.peak : out.head, sp);
   if (out.has_peak) out.top = edgePolyline(top, out.head, out.peak, sp);
+  if (footprint) {
+    // Between the corners (moved out already) each point of an edge goes out by the
+    // footprint's reach there; the edge's σ takes the reach's own uncertainty.
+    auto moveOut = [&](std::vector<Vec3>& line, double& sigma) {
+      if (line.size() < 3) return 0.0;
+      std::vector<Vec3> moved = line;
+      std::vector<uint32_t> idx;
+      std::vector<double> d2;
+      double sum = 0;
+      for (size_t i = 1; i + 1 < line.size(); ++i) {
+        const Vec3 t = (line[i + 1] - line[i - 1]).normalized();
+        const Vec3 in = acrossAt(line[i], line[i], t, samples, idx, d2).in;
+        const double s = footprintReach(p, *scanner, line[i], t.cross(in).normalized(), -in);
+        moved[i] = line[i] - s * in;
+        sum += s;
+      }
+      line = std::move(moved);
+      const double mean = sum / static_cast<double>(line.size() - 2);
+      sigma = std::hypot(sigma, kFootprintUncertainty * mean);
+      return mean;
+    };
+    const double at_luff = moveOut(out.luff, out.luff_sigma_m);
+    moveOut(out.foot, out.foot_sigma_m);
+    const double at_leech = moveOut(out.leech, out.leech_sigma_m);
+    out.footprint_reach_m = std::max(at_luff, at_leech);
+    if (out.has_peak) moveOut(out.top, out.top_sigma_m);
+  }
   out.luff_length_m = polylineLength(out.luff);
   out.leech_length_m = polylineLength(out.leech);
   out.foot_length_m = polylineLength(out.foot);

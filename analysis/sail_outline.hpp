@@ -2,6 +2,7 @@
 // The sail's outline on its mesh (SPEC §4 step 6): boundary = edges used by one
 // triangle; corners = the 3 (or 4 for square-top sails) boundary points with the
 // sharpest turning; luff, leech, foot (and top) are the boundary between them.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,16 @@ struct OutlineParams {
   std::vector<double> design_lengths_m;
   double design_tolerance = 0.10;
   double design_warning = 0.02;
+  // The scanner's beam (SPEC §3: exit diameter 8-13 mm, divergence 4.6-15 mrad,
+  // full angle). A return lies on the sail only while the beam's whole footprint
+  // does (one straddling an edge gives a mixed pixel, between sail and background,
+  // which the cleaning removes), so the samples stop short of every edge by the
+  // footprint's reach across it: exit/2 + range·divergence/2, stretched by the
+  // incidence. With both > 0 and the scanner's position known (the cloud's
+  // viewpoint), the edges and corners are moved out by that reach. 0: no correction
+  // (a cloud of unknown origin, or merged from several units).
+  double beam_exit_diameter_m = 0;
+  double beam_divergence_rad = 0;
 };
 
 struct SailOutline {
@@ -58,6 +69,10 @@ struct SailOutline {
     double area_m2 = 0;
     double luff_line_m = 0;  // the tack-head line at mid-luff, across the luff (the luff curve's sags are measured from it)
   } uncertainty;
+  // How far the beam's footprint kept the samples from the luff and leech (their
+  // mean reach, the larger; OutlineParams beam_*), m; 0 without that correction. A
+  // section's curve may stop this much further from its ends than a sampled one.
+  double footprint_reach_m = 0;
   std::vector<std::string> warnings;
 };
 
@@ -68,9 +83,11 @@ struct SailOutline {
 // least to those of them that lie inside both its edges and on the surface.
 // `sample_density_per_m2`: the density the outermost samples near a corner were
 // taken at, when the loose points are the scan's own and the mesh's vertices are
-// fewer (voxel means); 0: the mesh's vertices per square metre.
+// fewer (voxel means); 0: the mesh's vertices per square metre. `scanner`: where the
+// samples were measured from (the beam footprint correction needs it).
 SailOutline extractOutline(const Mesh& mesh, const OutlineParams& params = {},
-                           const std::vector<Vec3>& loose_points = {}, double sample_density_per_m2 = 0);
+                           const std::vector<Vec3>& loose_points = {}, double sample_density_per_m2 = 0,
+                           const std::optional<Vec3>& scanner = std::nullopt);
 
 // Length of a polyline, m.
 double polylineLength(const std::vector<Vec3>& line);

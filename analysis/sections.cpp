@@ -191,8 +191,11 @@ Bridge bridgeGap(const std::vector<Eigen::Vector2d>& xy, size_t i, double chord,
 // Gaps up to 10 % of the chord are kept as they are; wider ones inside the chord,
 // up to max_bridged_gap, are bridged by the cubic that meets the curve on either
 // side with its slope there. Returns false, saying why, when the curve does not
-// span the chord.
-bool pickCut(std::vector<Cut>& cuts, const Frame& f, double max_bridged_gap, Cut& out, std::string& why) {
+// span the chord: when it stops short of an end by more than 10 % of the chord
+// and `end_allowance` (the band along the edges a scanner's beam footprint keeps
+// it from, SailOutline::footprint_reach_m).
+bool pickCut(std::vector<Cut>& cuts, const Frame& f, double max_bridged_gap, double end_allowance, Cut& out,
+             std::string& why) {
   const Vec3& L = f.L;
   const double chord = f.chord;
   const Vec3& c_hat = f.c_hat;
@@ -223,10 +226,12 @@ bool pickCut(std::vector<Cut>& cuts, const Frame& f, double max_bridged_gap, Cut
   }
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.x < b.x; });
   const double pct = 100.0 / chord;
-  if (samples.front().x > 0.1 * chord || chord - samples.back().x > 0.1 * chord) {
-    const bool luff = samples.front().x > 0.1 * chord;
+  const double end_gap = 0.1 * chord + end_allowance;
+  if (samples.front().x > end_gap || chord - samples.back().x > end_gap) {
+    const bool luff = samples.front().x > end_gap;
     why = "leaves " + formatFixed(pct * (luff ? samples.front().x : chord - samples.back().x), 0) +
-          " % of the chord at the " + (luff ? "luff" : "leech") + " uncovered (at most 10 %)";
+          " % of the chord at the " + (luff ? "luff" : "leech") + " uncovered (at most " +
+          formatFixed(pct * end_gap, 0) + " %)";
     return false;
   }
   std::vector<Eigen::Vector2d> xy;
@@ -520,7 +525,7 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
     tilted.y_hat = tilted.m.cross(tilted.c_hat);
     auto cuts = cutMesh(mesh, g.normals, tilted.L, tilted.m);
     Cut c;
-    if (!pickCut(cuts, tilted, p.max_bridged_gap, c, why)) return false;
+    if (!pickCut(cuts, tilted, p.max_bridged_gap, g.outline.footprint_reach_m, c, why)) return false;
     f = tilted;
     cut = std::move(c);
     phi = angle;

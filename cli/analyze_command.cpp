@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "acquisition/sensor_model.hpp"
 #include "analysis/analysis_json.hpp"
 #include "analysis/cloud_io.hpp"
 #include "analysis/errors.hpp"
@@ -25,6 +26,7 @@ struct AnalyzeOptions {
   std::string json_out, mesh_out, params_file, cloud_out;
   bool print_params = false, no_segment = false, quiet = false;
   int corners = -1;
+  std::string scanner;  // lms111 / lms511: its beam footprint for the edges
 };
 
 void printTable(const SailAnalysis& a) {
@@ -81,6 +83,11 @@ void run(const AnalyzeOptions& o) {
   if (!o.plane.empty()) params.sections.plane = o.plane;
   if (o.no_segment) params.segment = false;
   if (o.corners >= 0) params.outline.corners = o.corners;
+  if (!o.scanner.empty()) {
+    const ScannerSpec spec = scannerSpec(parseScannerModel(o.scanner));
+    params.outline.beam_exit_diameter_m = spec.exit_diameter_m;
+    params.outline.beam_divergence_rad = spec.beam_divergence_rad;
+  }
   if (o.print_params) {
     std::cout << paramsToJson(params).dump(2) << "\n";
     return;
@@ -130,6 +137,13 @@ void addAnalyzeCommand(CLI::App& app) {
   cmd->add_option("--params", opt->params_file, "Pipeline parameters file (.json, .yaml or .yml); see --print-params");
   cmd->add_option("--corners", opt->corners, "Corners of the sail: 3, 4 (square top) or 0 for automatic")
       ->check(CLI::IsMember({0, 3, 4}));
+  cmd->add_option("--scanner", opt->scanner,
+                  "The scanner that measured the cloud (lms111 or lms511): a return comes off the sail only while "
+                  "its whole beam footprint lies on it, so the samples stop short of every edge by the footprint's "
+                  "reach (exit diameter/2 + range x divergence/2); the edges and corners are moved out by it. Needs "
+                  "the scanner's position: the cloud's viewpoint (PLY/PCD header, as sailshape's scans write it). "
+                  "Sets outline.beam_exit_diameter_m and beam_divergence_rad (see --print-params)")
+      ->check(CLI::IsMember({"lms111", "lms511"}, CLI::ignore_case));
   cmd->add_flag("--no-segment", opt->no_segment, "The input is the sail alone: skip segmentation");
   cmd->add_flag("--print-params", opt->print_params, "Print every pipeline parameter with its value and exit");
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress output");
