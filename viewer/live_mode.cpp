@@ -3,6 +3,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "acquisition/sensor_model.hpp"
 #include "analysis/design_compare.hpp"
 #include "analysis/errors.hpp"
 #include "database/schema.hpp"
@@ -197,6 +198,14 @@ LiveSweep LiveMode::analyse(int index, Acquisition a, double sweep_s, std::optio
     design = params_.design;
     form = params_.form;
     save_to = params_.save_to;
+  }
+  // A single unit's sweep: its beam's footprint trims every edge (SPEC §3), unless
+  // the parameters already name a beam.
+  if (a.model && a.cloud.viewpoint && options.analysis.outline.beam_exit_diameter_m == 0 &&
+      options.analysis.outline.beam_divergence_rad == 0) {
+    const ScannerSpec spec = scannerSpec(*a.model);
+    options.analysis.outline.beam_exit_diameter_m = spec.exit_diameter_m;
+    options.analysis.outline.beam_divergence_rad = spec.beam_divergence_rad;
   }
   LiveSweep r;
   r.index = index;

@@ -140,6 +140,8 @@ Acquisition ScannerSession::scan(const SweepOptions& options, const Progress& pr
   if (units_.size() == 1) {
     a.sweeps.push_back(runSweep(units_[0].config, options, progress));
     a.errors.push_back("");
+    a.cloud.viewpoint = a.sweeps.front().cloud.viewpoint;
+    a.model = units_[0].config.model;
   } else {
     std::vector<UnitConfig> configs;
     for (const auto& u : units_) configs.push_back(u.config);

@@ -61,6 +61,9 @@ struct Acquisition {
   std::vector<std::string> errors;       // per unit: empty, or why its sweep failed
   double start_spread_s = 0;
   std::vector<std::string> warnings;     // partial sweeps, ...
+  // One unit's sweep: the scanner it came from (the cloud's viewpoint is set too),
+  // whose beam footprint the outline corrects for. Several units: none.
+  std::optional<ScannerModel> model;
 };
 
 // A unit for the emulated deck scene (scene/boat frame: +X forward, +Y port, +Z up):

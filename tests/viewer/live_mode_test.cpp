@@ -124,6 +124,10 @@ TEST(LiveMode, SweepsAreAnalysedOneAfterAnotherAFailureIsReportedAndStopEndsIt) 
       EXPECT_LT(std::abs(r.delta->twist_deg), 1.5) << "f " << r.fraction;
     }
     EXPECT_FALSE(s.scene->surface.empty());
+    // One unit's sweep: the outline moves the edges out by its LMS511 beam's footprint, 13 mm
+    // across at the exit plus 4.7 mrad over the 5-10 m to the sail (SPEC §3): 1.8-3 cm.
+    EXPECT_GT(s.scene->analysis->outline.footprint_reach_m, 0.015);
+    EXPECT_LT(s.scene->analysis->outline.footprint_reach_m, 0.04);
     EXPECT_EQ(s.scene->cluster_deviation_m.size(), s.scene->analysis->sail_cloud.size());
     Database db = openSailDatabase(db_path);
     EXPECT_EQ(loadScanRecord(db, s.scan_id).sections.sections.size(), 2u) << "the analysis is stored with the sweep";
