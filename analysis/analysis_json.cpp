@@ -69,6 +69,8 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
     sail_sigma["peak_m"] = ou.peak_m;
     sail_sigma["top_length_m"] = ou.top_length_m;
   }
+  // How far the edges were moved out for the scanner's beam footprint (0: not).
+  j["sail"]["beam_footprint_m"] = o.footprint_reach_m;
   // 1σ: a corner's as the distance it may lie off, the rest in their own units.
   j["sail"]["uncertainty"] = std::move(sail_sigma);
   nlohmann::json sections = nlohmann::json::array();

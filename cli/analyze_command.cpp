@@ -46,6 +46,8 @@ void printTable(const SailAnalysis& a) {
   std::printf("  luff %.3f ± %.3f m, leech %.3f ± %.3f m, foot %.3f ± %.3f m", o.luff_length_m, u.luff_length_m,
               o.leech_length_m, u.leech_length_m, o.foot_length_m, u.foot_length_m);
   if (o.has_peak) std::printf(", top %.3f ± %.3f m", o.top_length_m, u.top_length_m);
+  if (o.footprint_reach_m > 0)
+    std::printf("\n  edges moved out by the beam's footprint, %.1f cm along luff and leech", 100 * o.footprint_reach_m);
   const LuffCurve& l = a.luff;
   std::printf("\n  luff curve: LUFA sag %.1f ± %.1f mm at %.0f ± %.0f %%, LUSW sag %.1f ± %.1f mm at %.0f ± %.0f %%\n\n",
               1000 * l.lufa_sag_m, 1000 * l.uncertainty.lufa_sag_m, l.lufa_position_pct, l.uncertainty.lufa_position_pct,

@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 
+#include "analysis/analysis_json.hpp"
 #include "analysis/cloud.hpp"
 #include "analysis/errors.hpp"
 #include "analysis/pipeline.hpp"
@@ -94,6 +95,8 @@ TEST(BeamFootprint, EdgesAndCornersComeBackOutToTheSailsTrueOutline) {
   EXPECT_GT(a.outline.luff_sigma_m, 0.25 * 0.025);
   EXPECT_GT(a.outline.footprint_reach_m, 0.02);
   EXPECT_LT(a.outline.footprint_reach_m, 0.04);
+  EXPECT_EQ(analysisToJson(a)["sail"]["beam_footprint_m"].get<double>(), a.outline.footprint_reach_m);
+  EXPECT_EQ(analysisToJson(plain)["sail"]["beam_footprint_m"].get<double>(), 0.0);
 }
 
 TEST(BeamFootprint, WithoutTheScannersPlaceTheEdgesStayAndAWarningSaysWhy) {

@@ -69,7 +69,7 @@ TEST_F(Cli, AnalyzeHelpMentionsEveryOption) {
   const Outcome r = sailshape("analyze --help");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   expectMentions(r.out, {"INPUT", "--sections", "--at", "--plane", "--json", "--mesh", "--sail-cloud", "--params",
-                         "--corners", "--no-segment", "--print-params", "-q", "--quiet"});
+                         "--corners", "--scanner", "--no-segment", "--print-params", "-q", "--quiet"});
 }
 
 TEST_F(Cli, SimulateHelpMentionsEveryOption) {
@@ -139,6 +139,15 @@ TEST_F(Cli, PrintParamsShowsAParameterFileAndTheOptionsApplied) {
   EXPECT_EQ(doc["region_growing"]["max_normal_angle_deg"], 7.0);
   EXPECT_EQ(doc["sections"]["count"], 5);
   EXPECT_EQ(doc["sections"]["plane"], "horizontal");
+  EXPECT_EQ(doc["outline"]["beam_exit_diameter_m"], 0.0) << "no beam unless the scanner is named";
+
+  // --scanner sets its beam (SPEC §3: the LMS511's 13 mm exit and 4.7 mrad), any case.
+  const Outcome named = sailshape("analyze --scanner LMS511 --print-params");
+  ASSERT_EQ(named.exit_code, 0) << named.err;
+  const json beam = json::parse(named.out)["outline"];
+  EXPECT_EQ(beam["beam_exit_diameter_m"], 0.013);
+  EXPECT_EQ(beam["beam_divergence_rad"], 0.0047);
+  EXPECT_EQ(sailshape("analyze --scanner lms200 --print-params").exit_code, 2);
 }
 
 TEST_F(Cli, SimulatedMainIsMeasuredWithinHalfAPercentOfCamber) {
