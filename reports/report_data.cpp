@@ -73,6 +73,8 @@ ReportOutline parseOutline(const std::string& text, int64_t analysis_id, const c
   read(sail, "foot_length_m", o.foot_length_m);
   read(sail, "top_length_m", o.top_length_m);
   read(sail, "area_m2", o.area_m2);
+  if (auto beam = sail.find("beam_footprint_m"); beam != sail.end() && beam->is_number())
+    o.beam_footprint_m = beam->get<double>();
   auto luff = sail.find("luff");
   if (luff != sail.end() && luff->is_object()) {
     read(*luff, "lufa_sag_pct", o.lufa_sag_pct);

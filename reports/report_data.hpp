@@ -36,6 +36,7 @@ struct ReportOutline {
   // The luff curve (SPEC §5): its largest sag in the sail's plane (LUFA) and to
   // leeward of it (LUSW), as % of the tack-head distance, and where along it.
   OutlineMeasure lufa_sag_pct, lufa_position_pct, lusw_sag_pct, lusw_position_pct;
+  double beam_footprint_m = 0;  // how far the edges were moved out for the scanner's beam (0: not)
 };
 
 // The same measures from an outline and its luff curve as analysed (the design's).

@@ -405,10 +405,13 @@ float outlineTable(PdfDocument& pdf, float y, const ReportOutline& design, const
     y += 14;
   }
   y += 4;
-  return pdf.paragraph(kMargin, y, w - 2 * kMargin,
-                       "Sags are the luff's largest offset from the straight line tack to head, as % of that line's "
-                       "length; in the sail's plane + is away from the clew.",
-                       8.5f, false, kGrey);
+  std::string note =
+      "Sags are the luff's largest offset from the straight line tack to head, as % of that line's length; in the "
+      "sail's plane + is away from the clew.";
+  if (flying.beam_footprint_m > 0)
+    note += " The flying edges were moved out " + fmt("%.1f", 100 * flying.beam_footprint_m) +
+            " cm for the scanner's beam: a return lies on the sail only while the whole beam does.";
+  return pdf.paragraph(kMargin, y, w - 2 * kMargin, note, 8.5f, false, kGrey);
 }
 
 void tablePage(PdfDocument& pdf, Pages& pages, const ReportData& d, const ReportStep& step, const StepComparison& c,

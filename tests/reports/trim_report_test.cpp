@@ -92,7 +92,7 @@ nlohmann::json flyingSection(const SailSurface& surface, double f, int k) {
 // step (halyard), the rest as printed by the report (3 and 2 decimals), each with a σ.
 void flyingOutline(nlohmann::json& doc, int k) {
   doc["sail"] = {{"luff_length_m", 10.012 + 0.02 * k}, {"leech_length_m", 10.481}, {"foot_length_m", 3.597},
-                 {"area_m2", 18.34 - 0.05 * k}};
+                 {"area_m2", 18.34 - 0.05 * k}, {"beam_footprint_m", 0.021 + 0.01 * k}};
   doc["sail"]["uncertainty"] = {{"luff_length_m", 0.004}, {"leech_length_m", 0.005}, {"foot_length_m", 0.003},
                                 {"area_m2", 0.02}};
   doc["luff"] = {{"lufa_sag_pct", 0.85 + 0.1 * k}, {"lufa_position_pct", 48.0}, {"lusw_sag_pct", -0.31},
@@ -391,6 +391,8 @@ TEST(TrimReport, OutlineShowsStoredFlyingAndAnalysedDesignLengths) {
     EXPECT_DOUBLE_EQ(o.area_m2.sigma, 0.02);
     EXPECT_DOUBLE_EQ(o.lufa_sag_pct.value, doc["luff"]["lufa_sag_pct"].get<double>());
     EXPECT_DOUBLE_EQ(o.lusw_position_pct.sigma, 9.0);
+    EXPECT_DOUBLE_EQ(o.beam_footprint_m, 0.021 + 0.01 * k);
+    EXPECT_NE(text.find("moved out " + fmt("%.1f", 2.1 + k) + " cm for the scanner"), std::string::npos) << k;
     const double dl = o.luff_length_m.value - r.design_outline.luff_length_m.value;
     const double dl_sigma = std::hypot(o.luff_length_m.sigma, r.design_outline.luff_length_m.sigma);
     EXPECT_NE(text.find(fmt("%.3f", o.luff_length_m.value) + " ± 0.004"), std::string::npos);
@@ -427,6 +429,7 @@ TEST(TrimReport, AnAnalysisWithoutItsOutlineShowsDashes) {
   p.out_path = dir.file("no-outline.pdf");
   const TrimReport report = writeTrimReport(p);
   EXPECT_TRUE(std::isnan(report.content.data.steps.front().outline.luff_length_m.value));
+  EXPECT_EQ(report.content.data.steps.front().outline.beam_footprint_m, 0.0);
   const std::string text = pdfText(p.out_path);
   const size_t at = text.find("Luff length, m");
   ASSERT_NE(at, std::string::npos);
