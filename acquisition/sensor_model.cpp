@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "analysis/errors.hpp"
+#include "analysis/sail_outline.hpp"
 
 namespace sailshape {
 
@@ -26,6 +27,12 @@ ScannerSpec scannerSpec(ScannerModel model) {
   // The recordings: LMS111 at 50 Hz / 0.5° from -45°, LMS511 at 25 Hz / 0.1667° from -5°.
   if (model == ScannerModel::Lms111) return {0.5, 20.0, -45.0, 225.0, 0.015, 0.008, 50.0, 0.5};
   return {0.7, 80.0, -5.0, 185.0, 0.0047, 0.013, 25.0, 1.0 / 6.0};
+}
+
+void useScannerBeam(OutlineParams& outline, ScannerModel model) {
+  const ScannerSpec spec = scannerSpec(model);
+  outline.beam_exit_diameter_m = spec.exit_diameter_m;
+  outline.beam_divergence_rad = spec.beam_divergence_rad;
 }
 
 MaterialResponse materialResponse(Material material) {

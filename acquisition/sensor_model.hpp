@@ -31,6 +31,11 @@ struct ScannerSpec {
 };
 ScannerSpec scannerSpec(ScannerModel model);
 
+struct OutlineParams;  // analysis/sail_outline.hpp
+// The outline's beam settings for a cloud this model measured: its footprint
+// trims every edge (OutlineParams::beam_exit_diameter_m, beam_divergence_rad).
+void useScannerBeam(OutlineParams& outline, ScannerModel model);
+
 // A beam's footprint as the emulator casts it: ray 0 is the axis from `origin`
 // along the unit `direction`; rays 1-4 leave the exit window's rim (offsets
 // rim_dirs[k] · exit radius) half the divergence out. Their directions are

@@ -85,11 +85,7 @@ void run(const AnalyzeOptions& o) {
   if (!o.plane.empty()) params.sections.plane = o.plane;
   if (o.no_segment) params.segment = false;
   if (o.corners >= 0) params.outline.corners = o.corners;
-  if (!o.scanner.empty()) {
-    const ScannerSpec spec = scannerSpec(parseScannerModel(o.scanner));
-    params.outline.beam_exit_diameter_m = spec.exit_diameter_m;
-    params.outline.beam_divergence_rad = spec.beam_divergence_rad;
-  }
+  if (!o.scanner.empty()) useScannerBeam(params.outline, parseScannerModel(o.scanner));
   if (o.print_params) {
     std::cout << paramsToJson(params).dump(2) << "\n";
     return;

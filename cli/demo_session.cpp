@@ -429,9 +429,7 @@ DemoResult runDemo(const DemoOptions& o, const DemoLog& log_fn, const Progress& 
         ap.sections = sp;
         // The unit's beam: its footprint trims every edge by 1.5-4 cm here, which put the
         // main's narrow head 11 cm and the A2's 22 cm low.
-        const ScannerSpec beam = scannerSpec(u.config.model);
-        ap.outline.beam_exit_diameter_m = beam.exit_diameter_m;
-        ap.outline.beam_divergence_rad = beam.beam_divergence_rad;
+        useScannerBeam(ap.outline, u.config.model);
         ap.outline.design_lengths_m = {u.design_sections.outline.luff_length_m, u.design_sections.outline.leech_length_m,
                                        u.design_sections.outline.foot_length_m};
         // The spars where this cloud has them: the registration is good to a couple of

@@ -202,11 +202,8 @@ LiveSweep LiveMode::analyse(int index, Acquisition a, double sweep_s, std::optio
   // A single unit's sweep: its beam's footprint trims every edge (SPEC §3), unless
   // the parameters already name a beam.
   if (a.model && a.cloud.viewpoint && options.analysis.outline.beam_exit_diameter_m == 0 &&
-      options.analysis.outline.beam_divergence_rad == 0) {
-    const ScannerSpec spec = scannerSpec(*a.model);
-    options.analysis.outline.beam_exit_diameter_m = spec.exit_diameter_m;
-    options.analysis.outline.beam_divergence_rad = spec.beam_divergence_rad;
-  }
+      options.analysis.outline.beam_divergence_rad == 0)
+    useScannerBeam(options.analysis.outline, *a.model);
   LiveSweep r;
   r.index = index;
   r.points = a.cloud.size();
