@@ -1274,6 +1274,30 @@ double footprintReach(const OutlineParams& p, const Vec3& origin, const Vec3& at
   return radius * std::sqrt(1.0 + tan2 * c * c);
 }
 
+// How far a corner moves when each of its edges a and b (meeting at `corner`, each
+// starting there when *_start) moves out by the beam's footprint: x with x·(−in_a) =
+// s_a and x·(−in_b) = s_b, in the corner's plane (far along the bisector at a narrow
+// head: a footprint of 1.5 cm moved a 20° head of a tunnel main 9 cm). The edges'
+// directions are taken over a tenth of their length: the corner curves' own tangents
+// where they meet, extrapolated past the samples, may close in (a tunnel main's 20°
+// head met at 3.7°, which moved it 67 cm). Zero where the edges are parallel.
+Vec3 footprintShift(const OutlineParams& p, const Vec3& scanner, const Vec3& corner, const Edge& a, bool a_start,
+                    const Edge& b, bool b_start, double spacing) {
+  auto chord = [&](const Edge& e, bool at_start) {
+    const double l = std::clamp(0.1 * e.length, std::min(e.exclude + spacing, 0.5 * e.length), 0.5 * e.length);
+    return Vec3(e.curve.at(at_start ? l : e.length - l) - corner).normalized();
+  };
+  const Vec3 ta = chord(a, a_start), tb = chord(b, b_start);
+  const Vec3 across_a = tb - tb.dot(ta) * ta, across_b = ta - ta.dot(tb) * tb;
+  const Vec3 plane_normal = ta.cross(tb);
+  if (!(plane_normal.norm() > 1e-3 && across_a.norm() > 1e-6 && across_b.norm() > 1e-6)) return Vec3::Zero();
+  const Vec3 n = plane_normal.normalized(), in_a = across_a.normalized(), in_b = across_b.normalized();
+  const double s_a = footprintReach(p, scanner, corner, n, -in_a);
+  const double s_b = footprintReach(p, scanner, corner, n, -in_b);
+  const double cc = in_a.dot(in_b), det = std::max(1.0 - cc * cc, 1e-6);
+  return ((-s_a + cc * s_b) * in_a + (-s_b + cc * s_a) * in_b) / det;
+}
+
 // The edge from corner to corner: the fitted curve between the excluded ends.
 std::vector<Vec3> edgePolyline(const Edge& e, const Vec3& first, const Vec3& last, double step) {
   std::vector<Vec3> out{first};
@@ -1504,34 +1528,9 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
     // Moving the two edges sideways by ε_a and ε_b moves their crossing across the
     // bisector by (ε_a − ε_b) / (2 cos(angle / 2)).
     const double across = std::hypot(m.side_a_m, m.side_b_m) / (2.0 * std::cos(std::min(0.5 * m.angle_rad, 1.4)));
-    // Each edge out by the beam's footprint: the corner moves by x with x·(−in_a) =
-    // s_a and x·(−in_b) = s_b, in the corner's plane (far along the bisector at a
-    // narrow head: a footprint of 1.5 cm moved a 20° head of a tunnel main 9 cm).
-    Vec3 point = c.point;
-    double footprint_sigma = 0;
-    if (footprint) {
-      // The edges' directions over a tenth of their length: the corner curves' own
-      // tangents where they meet, extrapolated past the samples, may close in (a
-      // tunnel main's 20° head met at 3.7°, which moved it 67 cm).
-      auto chord = [&](const Edge& e, bool at_start) {
-        const double l = std::clamp(0.1 * e.length, std::min(e.exclude + sp, 0.5 * e.length), 0.5 * e.length);
-        return Vec3(e.curve.at(at_start ? l : e.length - l) - point).normalized();
-      };
-      const Vec3 ta = chord(a, a_start), tb = chord(b, b_start);
-      const Vec3 across_a = tb - tb.dot(ta) * ta, across_b = ta - ta.dot(tb) * tb;
-      const Vec3 plane_normal = ta.cross(tb);
-      if (plane_normal.norm() > 1e-3 && across_a.norm() > 1e-6 && across_b.norm() > 1e-6) {
-        const Vec3 n = plane_normal.normalized(), in_a = across_a.normalized(), in_b = across_b.normalized();
-        const double s_a = footprintReach(p, *scanner, point, n, -in_a);
-        const double s_b = footprintReach(p, *scanner, point, n, -in_b);
-        const double cc = in_a.dot(in_b), det = std::max(1.0 - cc * cc, 1e-6);
-        const Vec3 x = ((-s_a + cc * s_b) * in_a + (-s_b + cc * s_a) * in_b) / det;
-        point += x;
-        footprint_sigma = kFootprintUncertainty * x.norm();
-      }
-    }
-    spread = {std::hypot(c.sigma_m, footprint_sigma), across, 0.5 * m.angle_rad};
-    return ontoSurface(point, mesh, tree, sp);
+    const Vec3 shift = footprint ? footprintShift(p, *scanner, c.point, a, a_start, b, b_start, sp) : Vec3(Vec3::Zero());
+    spread = {std::hypot(c.sigma_m, kFootprintUncertainty * shift.norm()), across, 0.5 * m.angle_rad};
+    return ontoSurface(Vec3(c.point + shift), mesh, tree, sp);
   };
   CornerSpread at_tack, at_clew, at_head, at_peak;
   out.tack = corner(luff, true, foot, true, at_tack);
