@@ -1,7 +1,9 @@
 #pragma once
 // The compressed cloud stored in scans.cloud: zlib over a small header
-// ("SSC1", point count, flags) and float32 xyz (metres) plus optional float32
-// intensity. float32 keeps ≈ 10 µm at 100 m, far below the sensor's σ (SPEC §3).
+// ("SSC1", point count, flags) and float32 xyz (metres), then what the cloud
+// has of: float32 intensity, float32 scan angles α and β (rad), the float64
+// viewpoint. float32 keeps ≈ 10 µm at 100 m, far below the sensor's σ (SPEC §3).
+// Blobs from before the angles and viewpoint were kept read as they were.
 #include <cstdint>
 #include <vector>
 
@@ -10,7 +12,8 @@
 namespace sailshape {
 
 std::vector<uint8_t> compressCloud(const Cloud& cloud);
-// Throws DatabaseError for a blob that is not a compressed cloud or is truncated.
+// Throws DatabaseError for a blob that is not a compressed cloud, is truncated or
+// carries flags this version does not know.
 Cloud decompressCloud(const std::vector<uint8_t>& blob);
 
 }  // namespace sailshape

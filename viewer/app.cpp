@@ -987,9 +987,12 @@ void App::drawProcessing() {
         ScanRecord record = loadScanRecord(*database_.db, browser_.selected_scan);
         if (!record.cloud) throw InvalidInput("scan " + std::to_string(record.scan_id) + " has no stored cloud to process");
         processing_.result_scan = record.scan_id;
-        processing_.note.clear();
+        ProcessingParams params = pp;
+        const std::string beam = useScanBeam(params, record);
+        processing_.note = beam.empty() ? "" : "scanner beam from the scan's unit (" + beam + "): its footprint is corrected at the edges";
+        processing_.result_params = params;
         processing_.task.start(std::string(stageName(*run)) + " on scan " + std::to_string(record.scan_id),
-                               [cloud = std::move(*record.cloud), params = pp, stage = *run](const Progress& p) {
+                               [cloud = std::move(*record.cloud), params = std::move(params), stage = *run](const Progress& p) {
                                  return runStages(cloud, params, stage, p);
                                });
       } catch (const std::exception& e) {
@@ -1015,7 +1018,7 @@ void App::drawProcessing() {
     ImGui::BeginDisabled(!r.analysis || running || !database_.db);
     if (ImGui::Button("Save analysis to database")) {
       try {
-        const int64_t id = saveStageResult(*database_.db, processing_.result_scan, r, pp);
+        const int64_t id = saveStageResult(*database_.db, processing_.result_scan, r, processing_.result_params);
         processing_.note = "saved as analysis " + std::to_string(id) + " of scan " + std::to_string(processing_.result_scan);
         log_.info(processing_.note);
         const int64_t scan = processing_.result_scan;

@@ -54,6 +54,7 @@ struct ProcessingState {
   Task<StageResult> task;
   std::optional<StageResult> result;
   int64_t result_scan = 0;
+  ProcessingParams result_params;   // what the result ran with (params, plus the scan's beam)
   bool show_result = true;
   std::string note;                 // last save or failure
 };

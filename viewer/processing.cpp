@@ -8,6 +8,7 @@
 #include "analysis/errors.hpp"
 #include "analysis/params_io.hpp"
 #include "database/import.hpp"
+#include "viewer/unit_camera.hpp"
 
 namespace sailshape::viewer {
 namespace {
@@ -69,7 +70,13 @@ StageResult runStages(const Cloud& input, const ProcessingParams& params, Proces
 
   Cloud cloud = cropToBox(input, params.roi);
   r.summary.push_back(count("after ROI", cloud.size()));
-  if (stage >= ProcessingStage::Filters) {
+  // The surface and sections stages leave the filters to analyzeSail, whose cleaning
+  // gives back the surface points they removed and lets the corners test the rest,
+  // as `sailshape analyze` does: filtered here, a narrow head lost its tip (the
+  // statistical test takes a corner's lone samples) and read 5 cm low. The filters
+  // measure distances only, so running them after the transform changes nothing.
+  const bool analyse = stage >= ProcessingStage::Surface;
+  if (stage >= ProcessingStage::Filters && !analyse) {
     if (ap.statistical_outliers) {
       const Cleaning c = removeStatisticalOutliers(cloud, ap.statistical, progress);
       cloud = selectPoints(cloud, c.kept);
@@ -108,15 +115,22 @@ StageResult runStages(const Cloud& input, const ProcessingParams& params, Proces
                           std::to_string(seg.clusters[pick.cluster].size()) + " points)");
     }
   }
-  if (stage >= ProcessingStage::Surface) {
-    AnalysisParams p = ap;
-    p.statistical_outliers = false;  // the Filters stage ran them before the transform
-    p.radius_outliers = false;
-    SailAnalysis a = analyzeSail(cloud, p, progress);
+  if (analyse) {
+    SailAnalysis a = analyzeSail(cloud, ap, progress);
+    const StageReport* cleaned = nullptr;
+    for (const StageReport& s : a.stages)
+      if (s.name == "statistical outliers" || s.name == "radius outliers" || s.name == "readmit surface points")
+        cleaned = &s;
+    if (cleaned) r.summary.push_back(count("after filters", cleaned->points_out));
     r.summary.push_back(count("sail", a.sail_points));
     char area[96];
     std::snprintf(area, sizeof area, "%zu triangles, area %.2f m²", a.mesh.triangles.size(), a.outline.area_m2);
     r.summary.push_back(area);
+    if (a.outline.footprint_reach_m > 0) {
+      char moved[96];
+      std::snprintf(moved, sizeof moved, "edges moved out by the beam's footprint, %.1f cm", 100 * a.outline.footprint_reach_m);
+      r.summary.push_back(moved);
+    }
     r.summary.push_back(std::to_string(a.sections.sections.size()) + " sections");
     r.warnings.insert(r.warnings.end(), a.warnings.begin(), a.warnings.end());
     cloud = a.sail_cloud;
@@ -124,6 +138,16 @@ StageResult runStages(const Cloud& input, const ProcessingParams& params, Proces
   }
   r.cloud = std::move(cloud);
   return r;
+}
+
+std::string useScanBeam(ProcessingParams& params, const ScanRecord& record) {
+  OutlineParams& outline = params.analysis.outline;
+  if (outline.beam_exit_diameter_m != 0 || outline.beam_divergence_rad != 0) return {};
+  if (!record.cloud || !record.cloud->viewpoint) return {};
+  const std::optional<UnitConfig> unit = scanUnit(record);
+  if (!unit) return {};
+  useScannerBeam(outline, unit->model);
+  return scannerModelName(unit->model);
 }
 
 int64_t saveStageResult(Database& db, int64_t scan_id, const StageResult& result, const ProcessingParams& params) {

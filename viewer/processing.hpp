@@ -11,6 +11,10 @@
 #include "analysis/pipeline.hpp"
 #include "database/sqlite.hpp"
 
+namespace sailshape {
+struct ScanRecord;  // database/scan_record.hpp
+}  // namespace sailshape
+
 namespace sailshape::viewer {
 
 enum class ProcessingStage { Roi, Filters, Transform, Normals, Segmentation, Surface, Sections };
@@ -35,7 +39,8 @@ struct ProcessingParams {
   RoiBox roi;
   CloudTransform transform;
   // Every pipeline parameter; the Filters tab owns statistical/radius outliers
-  // (run before the transform), the later stages the rest.
+  // (run before the transform up to the segmentation stage; the surface and
+  // sections stages run them inside analyzeSail), the later stages the rest.
   AnalysisParams analysis;
 };
 
@@ -57,6 +62,13 @@ Cloud transformCloud(const Cloud& cloud, const CloudTransform& transform);
 // parameters, AnalysisError when a stage cannot produce its result.
 StageResult runStages(const Cloud& input, const ProcessingParams& params, ProcessingStage stage,
                       const Progress& progress = {});
+
+// For a re-analysis of `record`'s stored cloud: when `params` set no beam and the
+// scan's stored settings name the unit's scanner model, sets that model's beam
+// (acquisition/sensor_model useScannerBeam), so the edges move out by its
+// footprint as the scan's first analysis did. Needs the cloud's viewpoint.
+// Returns the model's name ("lms511"), empty when it set nothing.
+std::string useScanBeam(ProcessingParams& params, const ScanRecord& record);
 
 // Stores a surface/sections result as a new analysis of `scan_id` (the scan
 // keeps its earlier analyses). Throws InvalidInput when the result has no analysis.

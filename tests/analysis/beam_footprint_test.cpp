@@ -5,58 +5,23 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 #include <string>
 
 #include "analysis/analysis_json.hpp"
 #include "analysis/cloud.hpp"
 #include "analysis/errors.hpp"
 #include "analysis/pipeline.hpp"
+#include "footprint_scan.hpp"
 
 namespace sailshape {
 namespace {
 
-// A flat triangular main in the plane y = 0, 10 m luff, its head's angle 19°.
-const Vec3 kTack(0.0, 0.0, 1.0), kHead(-0.5, 0.0, 11.0), kClew(-3.6, 0.0, 1.3);
-// An LMS511 (SPEC §3: exit 13 mm, divergence 4.7 mrad) 8 m to windward.
-const Vec3 kScanner(-1.5, -8.0, 5.0);
-constexpr double kExit = 0.013, kDivergence = 0.0047;
+using test::kClew;
+using test::kHead;
+using test::kTack;
+constexpr double kExit = 0.013, kDivergence = 0.0047;  // an LMS511 (SPEC §3: exit 13 mm, 4.7 mrad)
 
-bool insideTriangle(const Vec3& p) {
-  auto side = [](const Vec3& a, const Vec3& b, const Vec3& q) {
-    return (b.x() - a.x()) * (q.z() - a.z()) - (b.z() - a.z()) * (q.x() - a.x());
-  };
-  const double s1 = side(kTack, kHead, p), s2 = side(kHead, kClew, p), s3 = side(kClew, kTack, p);
-  return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
-}
-
-// Samples spread uniformly over the sail, each kept only when its whole beam lies
-// on the sail: 32 rays round the beam's rim (leaving the exit window's edge,
-// spreading at half the divergence) all land inside the triangle. The beam is
-// modelled here ray by ray, apart from how the outline corrects for it.
-Cloud scanWithFootprint(int samples, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-  Cloud c;
-  c.viewpoint = kScanner;
-  for (int i = 0; i < samples; ++i) {  // the trimmed band is left empty, the rest at one density
-    double a = u01(rng), b = u01(rng);
-    if (a + b > 1) a = 1 - a, b = 1 - b;
-    const Vec3 p = kTack + a * (kHead - kTack) + b * (kClew - kTack);
-    const Vec3 d = (p - kScanner).normalized();
-    const Vec3 e1 = d.unitOrthogonal(), e2 = d.cross(e1);
-    bool whole = true;
-    for (int k = 0; k < 32 && whole; ++k) {
-      const double phi = 2.0 * M_PI * k / 32.0;
-      const Vec3 rim = std::cos(phi) * e1 + std::sin(phi) * e2;
-      const Vec3 origin = kScanner + 0.5 * kExit * rim, dir = d + 0.5 * kDivergence * rim;
-      const Vec3 hit = origin + (-origin.y() / dir.y()) * dir;  // onto y = 0
-      whole = insideTriangle(hit);
-    }
-    if (whole) c.points.push_back(p);
-  }
-  return c;
-}
+Cloud scanWithFootprint(int samples, unsigned seed) { return test::scanWithFootprint(samples, seed, kExit, kDivergence); }
 
 AnalysisParams sailOnly() {
   AnalysisParams p;

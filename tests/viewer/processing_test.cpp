@@ -4,6 +4,8 @@
 #include "analysis/sail_generator.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/processing.hpp"
+#include "../analysis/footprint_scan.hpp"
+#include "acquisition/unit_config.hpp"
 #include "viewer_fixture.hpp"
 
 namespace sailshape::viewer {
@@ -127,6 +129,60 @@ TEST(Processing, SectionsStageMeasuresTheKnownSailAndSavesIt) {
   ASSERT_EQ(back.sections.sections.size(), 3u);
   EXPECT_NEAR(back.sections.sections[1].value.camber_pct, r.analysis->sections.sections[1].value.camber_pct, 1e-9);
   EXPECT_FALSE(back.analysis_params["segment"].get<bool>());
+}
+
+TEST(Processing, AStoredScanIsReanalysedWithItsUnitsBeam) {
+  // An LMS511's scan of a flat main that stops short of every edge by the beam's
+  // footprint, stored with its unit's settings as a sweep stores them.
+  const ScannerSpec spec = scannerSpec(ScannerModel::Lms511);
+  const Cloud cloud = test::scanWithFootprint(40000, 7, spec.exit_diameter_m, spec.beam_divergence_rad);
+  test::TempDir dir;
+  Database db = openSailDatabase(dir.file("p.sqlite"));
+  UnitConfig unit;
+  unit.model = ScannerModel::Lms511;
+  ImportMetadata meta;
+  meta.sail = "main-A";
+  meta.test = "upwind";
+  meta.trim_step = 1;
+  meta.settings = nlohmann::json::parse(unitToJson(unit));
+  const int64_t scan = importScan(db, meta, nullptr, &cloud).scan_id;
+  meta.trim_step = 2;
+  meta.settings = nullptr;  // a cloud imported from a file: no unit known
+  const int64_t unknown = importScan(db, meta, nullptr, &cloud).scan_id;
+
+  const ScanRecord record = loadScanRecord(db, scan);
+  ASSERT_TRUE(record.cloud && record.cloud->viewpoint);
+  EXPECT_EQ(*record.cloud->viewpoint, test::kScanner);
+  ProcessingParams params;
+  params.analysis.segment = false;
+  params.analysis.sensor_sigma_m = 0.001;  // noise-free samples
+  EXPECT_EQ(useScanBeam(params, record), "lms511");
+  EXPECT_EQ(params.analysis.outline.beam_exit_diameter_m, spec.exit_diameter_m);
+  EXPECT_EQ(params.analysis.outline.beam_divergence_rad, spec.beam_divergence_rad);
+  const StageResult r = runStages(*record.cloud, params, ProcessingStage::Sections);
+  ASSERT_TRUE(r.analysis.has_value());
+  // Issue 2's corner target, as the first analysis with the beam reaches it
+  // (tests/analysis/beam_footprint_test.cpp); uncorrected the head is 10 cm and more low.
+  EXPECT_LT((r.analysis->outline.head - test::kHead).norm(), 0.03);
+  EXPECT_LT((r.analysis->outline.tack - test::kTack).norm(), 0.03);
+  EXPECT_NEAR(r.analysis->outline.luff_length_m, (test::kHead - test::kTack).norm(), 0.01);
+  bool said = false;
+  for (const std::string& line : r.summary) said |= line.rfind("edges moved out by the beam's footprint, ", 0) == 0;
+  EXPECT_TRUE(said);
+
+  // A beam set by hand stays; no unit, or no viewpoint, sets none.
+  ProcessingParams own;
+  own.analysis.outline.beam_exit_diameter_m = 0.02;
+  EXPECT_EQ(useScanBeam(own, record), "");
+  EXPECT_EQ(own.analysis.outline.beam_exit_diameter_m, 0.02);
+  EXPECT_EQ(own.analysis.outline.beam_divergence_rad, 0.0);
+  ProcessingParams none;
+  EXPECT_EQ(useScanBeam(none, loadScanRecord(db, unknown)), "");
+  EXPECT_EQ(none.analysis.outline.beam_exit_diameter_m, 0.0);
+  ScanRecord blind = record;
+  blind.cloud->viewpoint.reset();
+  EXPECT_EQ(useScanBeam(none, blind), "");
+  EXPECT_EQ(none.analysis.outline.beam_divergence_rad, 0.0);
 }
 
 TEST(Processing, RefusesWhatItCannotDo) {
