@@ -178,7 +178,9 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
   if (!(p.working_voxel_of_extent > 0) || !std::isfinite(p.working_voxel_of_extent))
     throw InvalidInput("[analyzeSail] working_voxel_of_extent must be > 0 and finite (got " +
                        std::to_string(p.working_voxel_of_extent) + ")");
-  {  // the sections come last: a bad parameter of theirs is reported before the work, not after
+  // The outline and sections come last: a bad parameter of theirs is reported before the work, not after.
+  checkOutlineParams(p.outline);
+  {
     SectionParams sp = p.sections;
     sp.sensor_sigma_m = p.sensor_sigma_m;
     checkSectionParams(sp);

@@ -1330,20 +1330,24 @@ Vec3 pointAtFraction(const std::vector<Vec3>& line, double fraction) {
   return line.back();
 }
 
-SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::vector<Vec3>& loose_points,
-                           double sample_density_per_m2, const std::optional<Vec3>& scanner) {
-  if (mesh.triangles.empty()) throw InvalidInput("[extractOutline] empty mesh");
+void checkOutlineParams(const OutlineParams& p) {
   if (!(p.beam_exit_diameter_m >= 0) || !(p.beam_divergence_rad >= 0) || p.beam_exit_diameter_m > 1 ||
       p.beam_divergence_rad > 0.5)
     throw InvalidInput("[extractOutline] beam_exit_diameter_m must be in [0, 1] and beam_divergence_rad in [0, 0.5] (got " +
                        formatFixed(p.beam_exit_diameter_m, 4) + ", " + formatFixed(p.beam_divergence_rad, 4) + ")");
-  const bool beam_given = p.beam_exit_diameter_m > 0 || p.beam_divergence_rad > 0;
-  const bool footprint = beam_given && scanner.has_value();
   if (p.corners != 0 && p.corners != 3 && p.corners != 4)
     throw InvalidInput("[extractOutline] corners must be 0 (auto), 3 or 4 (got " + std::to_string(p.corners) + ")");
   if (!p.design_lengths_m.empty() && p.design_lengths_m.size() != 3)
     throw InvalidInput("[extractOutline] design_lengths_m must be [luff, leech, foot] (got " +
                        std::to_string(p.design_lengths_m.size()) + " values)");
+}
+
+SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::vector<Vec3>& loose_points,
+                           double sample_density_per_m2, const std::optional<Vec3>& scanner) {
+  if (mesh.triangles.empty()) throw InvalidInput("[extractOutline] empty mesh");
+  checkOutlineParams(p);
+  const bool beam_given = p.beam_exit_diameter_m > 0 || p.beam_divergence_rad > 0;
+  const bool footprint = beam_given && scanner.has_value();
   SailOutline out;
   if (beam_given && !scanner)
     out.warnings.push_back("the beam's footprint is given but not where the scanner stood (the cloud has no viewpoint): "

@@ -76,6 +76,10 @@ struct SailOutline {
   std::vector<std::string> warnings;
 };
 
+// Throws InvalidInput for bad parameters (extractOutline checks them first; the
+// pipeline before it starts).
+void checkOutlineParams(const OutlineParams& params);
+
 // Throws AnalysisError when the mesh has no boundary loop, the corners cannot be
 // told apart, or a length is more than design_tolerance off its design value.
 // `loose_points`: points of the sail the mesh left out (a lone sample near a

@@ -84,7 +84,22 @@ TEST(BeamFootprint, WithoutTheScannersPlaceTheEdgesStayAndAWarningSaysWhy) {
 TEST(BeamFootprint, ABeamOutsideWhatAScannerHasIsRefused) {
   AnalysisParams p = sailOnly();
   p.outline.beam_divergence_rad = -0.001;
-  EXPECT_THROW(analyzeSail(scanWithFootprint(5000, 1), p), InvalidInput);
+  const std::string why =
+      "[extractOutline] beam_exit_diameter_m must be in [0, 1] and beam_divergence_rad in [0, 0.5] (got 0.0000, -0.0010)";
+  // Refused before the work: three points would otherwise fail later, for want of a surface.
+  Cloud three;
+  three.points = {kTack, kHead, kClew};
+  for (const Cloud& cloud : {scanWithFootprint(5000, 1), three}) {
+    try {
+      analyzeSail(cloud, p);
+      FAIL() << "a negative divergence was taken";
+    } catch (const InvalidInput& e) {
+      EXPECT_EQ(std::string(e.what()), why);
+    }
+  }
+  p.outline.beam_divergence_rad = kDivergence;
+  p.outline.beam_exit_diameter_m = 1.5;
+  EXPECT_THROW(analyzeSail(three, p), InvalidInput);
 }
 
 }  // namespace
