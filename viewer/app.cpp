@@ -13,6 +13,7 @@
 #include "database/scan_record.hpp"
 #include "database/schema.hpp"
 #include "acquisition/scene.hpp"
+#include "acquisition/sensor_model.hpp"
 #include "analysis/sail_generator.hpp"
 #include "reports/trim_report.hpp"
 
@@ -49,6 +50,17 @@ bool begin(const char* name, float x, float y, float w, float h, ImGuiWindowFlag
   ImGui::SetNextWindowPos(ImVec2(x, y));
   ImGui::SetNextWindowSize(ImVec2(std::max(w, 1.0f), std::max(h, 1.0f)));
   return ImGui::Begin(name, nullptr, kPanelFlags | extra);
+}
+
+std::string beamHelp() {
+  const ScannerSpec a = scannerSpec(ScannerModel::Lms511), b = scannerSpec(ScannerModel::Lms111);
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "the scanner's beam: its footprint keeps the samples short of every edge, and the edges and corners "
+                "are moved back out by it. Both 0: taken from the scan's unit when its stored settings name the "
+                "model (LMS511: %.3f m, %.4f rad; LMS111: %.3f m, %.4f rad)",
+                a.exit_diameter_m, a.beam_divergence_rad, b.exit_diameter_m, b.beam_divergence_rad);
+  return text;
 }
 
 void helpMarker(const char* text) {
@@ -967,6 +979,9 @@ void App::drawProcessing() {
           inputDouble("entry/exit window", &ap.sections.end_window, 0.01, "%.2f");
           inputDouble("peak window", &ap.sections.peak_window, 0.01, "%.2f");
           inputDouble("sensor σ (m)", &ap.sensor_sigma_m, 0.001, "%.4f");
+          inputDouble("beam exit (m)", &ap.outline.beam_exit_diameter_m, 0.001, "%.4f");
+          inputDouble("beam divergence (rad)", &ap.outline.beam_divergence_rad, 0.0005, "%.4f");
+          helpMarker(beamHelp().c_str());
           break;
       }
       ImGui::PopItemWidth();
