@@ -21,12 +21,27 @@ using sailshape::testing::runSailshape;
 
 namespace {
 
-fs::path freshDir(const std::string& name) {
-  const fs::path d = fs::path(::testing::TempDir()) / ("acq_cli_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+// A test's own directory under the test temp dir. It goes when the test passes and
+// stays, with the emulator's and the command's output, when it fails.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& name)
+      : path_(fs::path(::testing::TempDir()) / ("acq_cli_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    if (!::testing::Test::HasFailure()) fs::remove_all(path_, ec);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  operator const fs::path&() const { return path_; }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
 
 void writeText(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
@@ -75,7 +90,7 @@ class EmulatorProcess {
 }  // namespace
 
 TEST(AcquisitionCli, HelpExplainsTheOptions) {
-  const fs::path d = freshDir("help");
+  const ScratchDir d("help");
   auto r = runSailshape(d, "emulate --help");
   EXPECT_EQ(r.exit_code, 0);
   for (const char* opt : {"--model", "--scene", "--port", "--serial-link", "--unit", "--bind", "--spin-up"})
@@ -91,7 +106,7 @@ TEST(AcquisitionCli, HelpExplainsTheOptions) {
 }
 
 TEST(AcquisitionCli, EmulateScanAndCalibrate) {
-  const fs::path d = freshDir("e2e");
+  const ScratchDir d("e2e");
   writeText(d / "room.json", kRoom);
   writeText(d / "truth.json", R"({"name": "truth", "p_m": 0.105, "theta_deg": 12})");
   EmulatorProcess emu(d, "--model lms511 --port 0 --scene '" + (d / "room.json").string() + "' --unit '" +
@@ -138,7 +153,7 @@ TEST(AcquisitionCli, EmulateScanAndCalibrate) {
 }
 
 TEST(AcquisitionCli, AScannerStillSpinningUpPastTheReadyTimeoutIsOneErrorAndNoScanIsWritten) {
-  const fs::path d = freshDir("spinup");
+  const ScratchDir d("spinup");
   writeText(d / "room.json", kRoom);
   EmulatorProcess emu(d, "--model lms511 --port 0 --spin-up 60 --scene '" + (d / "room.json").string() +
                              "' --serial-link '" + (d / "tt").string() + "' --duration 60");
@@ -167,7 +182,7 @@ TEST(AcquisitionCli, AScannerStillSpinningUpPastTheReadyTimeoutIsOneErrorAndNoSc
 }
 
 TEST(AcquisitionCli, ErrorsAreOneLine) {
-  const fs::path d = freshDir("errors");
+  const ScratchDir d("errors");
   writeText(d / "bad_scene.json", R"({"objects": [{"type": "torus"}]})");
   writeText(d / "bad_unit.json", R"({"speed_deg_s": -1})");
   writeText(d / "bad.csv", "range_m,alpha_rad,beta_rad,rssi,time_s\n1,2\n");
