@@ -1066,7 +1066,27 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
       }
     }
   } else {
-    const CornerCurve fa = ontoFrontier(ca, cb, smp, spacing, false), fb = ontoFrontier(cb, ca, smp, spacing, false);
+    CornerCurve fa = ontoFrontier(ca, cb, smp, spacing, false), fb = ontoFrontier(cb, ca, smp, spacing, false);
+    // Once more from the frontier curves, over the corner curves' reach. A window's
+    // outermost sample is measured from the curve, and where that curve strays from
+    // the edge within the window (the corner curve through boundary vertices, a
+    // window 0.8 m long at 12,000 points) the least offset is the edge's furthest
+    // excursion there, not its place: a sparse gennaker's first leech window lay
+    // 2.7 cm out, a cubic followed it and the head came out 5 cm low. Measured from
+    // the frontier curve, the edge runs nearly straight in each window. Heads over
+    // 3 cm: 12,000-point gennakers 12 → 7 of 20, 20,000-point 2 → 1, 12,000-point
+    // mains 2 → 1; at 40,000 points unchanged (bench/generator-sweep/README.md).
+    auto again = [&](const CornerCurve& f, const CornerCurve& c, const CornerCurve& other) {
+      if (!f.on_frontier) return f;
+      CornerCurve r = f;
+      r.from = c.from;
+      r.to = c.to;
+      const CornerCurve g = ontoFrontier(r, other, smp, spacing, false);
+      return g.on_frontier ? g : f;
+    };
+    const CornerCurve first_a = fa;
+    fa = again(fa, ca, fb);
+    fb = again(fb, cb, first_a);
     ca = fa;
     cb = fb;
     if (a.on_envelope && b.on_envelope) {
