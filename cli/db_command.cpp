@@ -274,12 +274,24 @@ void addDbCommand(CLI::App& app) {
   add_db(show);
   show->add_option("SCAN_ID", o->scan_id, "Scan id (see db list)")->required();
   show->add_flag("--json", o->json, "Print JSON");
+  show->add_option("--cloud", o->cloud_file,
+                   "Also write the scan's stored cloud to this file (.ply, .pcd, .xyz or .csv by its extension): its "
+                   "points with their intensity and scan angles, and the scanner's viewpoint, as stored; "
+                   "`sailshape analyze FILE --scanner MODEL` re-analyses it as the first analysis did");
   show->callback([o] {
     Database d = openSailDatabase(o->db, openOptions(*o, false));
     ScanFilter f;
     f.scan_id = o->scan_id;
     const Table scan = findScans(d, f);
     if (scan.rows.empty()) throw InvalidInput("db show: no scan " + std::to_string(o->scan_id) + " in " + o->db);
+    if (!o->cloud_file.empty()) {
+      const ScanRecord record = loadScanRecord(d, o->scan_id);
+      if (!record.cloud)
+        throw InvalidInput("db show: scan " + std::to_string(o->scan_id) + " has no stored cloud (only its analysis was imported)");
+      writeCloud(o->cloud_file, *record.cloud);
+      std::fprintf(stderr, "wrote the stored cloud of scan %lld (%zu points) to %s\n", static_cast<long long>(o->scan_id),
+                   record.cloud->size(), o->cloud_file.c_str());
+    }
     const Table sections = findSections(d, f);
     // Sections the latest analysis was asked for but could not measure.
     const int64_t analysis_id = latestAnalysisId(d, o->scan_id);

@@ -118,6 +118,46 @@ TEST_F(DbCli, ShowNamesTheSectionsTheAnalysisCouldNotMeasure) {
   EXPECT_EQ(j["unmeasured_sections"][0]["reason"].get<std::string>(), why);
 }
 
+TEST_F(DbCli, ShowWritesTheStoredCloudBackWithItsAnglesAndViewpoint) {
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  const fs::path in = dir_ / "scan.ply";
+  {
+    std::ofstream f(in);
+    f << "ply\nformat ascii 1.0\ncomment viewpoint -8 -9.5 5.25\nelement vertex 3\n"
+         "property double x\nproperty double y\nproperty double z\n"
+         "property double alpha_rad\nproperty double beta_rad\nend_header\n"
+         "1 2 3 0.5 1.5\n4 5 6 0.25 1.75\n7 8 9 -0.125 2\n";
+  }
+  ASSERT_EQ(run("db import " + db_ + " " + in.string() + " --sail G1").exit_code, 0);
+  const std::string out = (dir_ / "back.xyz").string();
+  const Outcome show = run("db show " + db_ + " 1 --cloud " + out);
+  ASSERT_EQ(show.exit_code, 0) << show.err;
+  EXPECT_NE(show.err.find("wrote the stored cloud of scan 1 (3 points) to " + out), std::string::npos) << show.err;
+  // Read back by the same reader `analyze` uses: the points (float32 in the
+  // database), their angles and the viewpoint as imported.
+  const Outcome again = run("db import " + db_ + " " + out + " --sail G1 --trim-step 2");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const std::string twice = (dir_ / "twice.ply").string();
+  ASSERT_EQ(run("db show " + db_ + " 2 --cloud " + twice).exit_code, 0);
+  const std::string text = readText(out);
+  EXPECT_NE(text.find("viewpoint -8 -9.5 5.25"), std::string::npos) << text;
+  EXPECT_NE(text.find("alpha_rad"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n7 8 9 -0.125 2"), std::string::npos) << text;
+  const std::string ply = readText(twice);
+  EXPECT_NE(ply.find("comment viewpoint -8 -9.5 5.25"), std::string::npos);
+  EXPECT_NE(ply.find("property double beta_rad"), std::string::npos);
+  EXPECT_NE(ply.find("element vertex 3"), std::string::npos);
+
+  // A scan stored from its analysis alone has no cloud to write.
+  ASSERT_EQ(run("db import " + db_ + " " + analysisJson(8) + " --sail G1 --trim-step 3").exit_code, 0);
+  const Outcome none = run("db show " + db_ + " 3 --cloud " + (dir_ / "none.ply").string());
+  EXPECT_NE(none.exit_code, 0);
+  EXPECT_EQ(countLines(none.err), 1) << none.err;
+  EXPECT_NE(none.err.find("db show: scan 3 has no stored cloud (only its analysis was imported)"), std::string::npos)
+      << none.err;
+  EXPECT_FALSE(fs::exists(dir_ / "none.ply"));
+}
+
 TEST_F(DbCli, ErrorsAreOneLineAndNonZero) {
   const std::string notes = (dir_ / "notes.db").string();
   std::ofstream(notes) << "not a database, just a long enough line of text to fill a header\n";
