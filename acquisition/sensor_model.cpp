@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "analysis/errors.hpp"
+#include "analysis/cloud.hpp"
 #include "analysis/sail_outline.hpp"
 
 namespace sailshape {
@@ -33,6 +34,12 @@ void useScannerBeam(OutlineParams& outline, ScannerModel model) {
   const ScannerSpec spec = scannerSpec(model);
   outline.beam_exit_diameter_m = spec.exit_diameter_m;
   outline.beam_divergence_rad = spec.beam_divergence_rad;
+}
+
+bool useScannerBeamUnlessGiven(OutlineParams& outline, ScannerModel model, const Cloud& cloud) {
+  if (outline.beamGiven() || !cloud.viewpoint) return false;
+  useScannerBeam(outline, model);
+  return true;
 }
 
 MaterialResponse materialResponse(Material material) {

@@ -32,9 +32,13 @@ struct ScannerSpec {
 ScannerSpec scannerSpec(ScannerModel model);
 
 struct OutlineParams;  // analysis/sail_outline.hpp
+struct Cloud;          // analysis/cloud.hpp
 // The outline's beam settings for a cloud this model measured: its footprint
 // trims every edge (OutlineParams::beam_exit_diameter_m, beam_divergence_rad).
 void useScannerBeam(OutlineParams& outline, ScannerModel model);
+// The same for `cloud`, unless the outline names a beam already or the cloud has
+// no viewpoint to place the footprint from. Whether it set the beam.
+bool useScannerBeamUnlessGiven(OutlineParams& outline, ScannerModel model, const Cloud& cloud);
 
 // A beam's footprint as the emulator casts it: ray 0 is the axis from `origin`
 // along the unit `direction`; rays 1-4 leave the exit window's rim (offsets

@@ -1375,7 +1375,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
                            double sample_density_per_m2, const std::optional<Vec3>& scanner) {
   if (mesh.triangles.empty()) throw InvalidInput("[extractOutline] empty mesh");
   checkOutlineParams(p);
-  const bool beam_given = p.beam_exit_diameter_m > 0 || p.beam_divergence_rad > 0;
+  const bool beam_given = p.beamGiven();
   const bool footprint = beam_given && scanner.has_value();
   SailOutline out;
   if (beam_given && !scanner)

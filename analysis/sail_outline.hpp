@@ -36,6 +36,7 @@ struct OutlineParams {
   // (a cloud of unknown origin, or merged from several units).
   double beam_exit_diameter_m = 0;
   double beam_divergence_rad = 0;
+  bool beamGiven() const { return beam_exit_diameter_m != 0 || beam_divergence_rad != 0; }
 };
 
 struct SailOutline {

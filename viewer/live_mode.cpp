@@ -201,9 +201,7 @@ LiveSweep LiveMode::analyse(int index, Acquisition a, double sweep_s, std::optio
   }
   // A single unit's sweep: its beam's footprint trims every edge (SPEC §3), unless
   // the parameters already name a beam.
-  if (a.model && a.cloud.viewpoint && options.analysis.outline.beam_exit_diameter_m == 0 &&
-      options.analysis.outline.beam_divergence_rad == 0)
-    useScannerBeam(options.analysis.outline, *a.model);
+  if (a.model) useScannerBeamUnlessGiven(options.analysis.outline, *a.model, a.cloud);
   LiveSweep r;
   r.index = index;
   r.points = a.cloud.size();

@@ -141,12 +141,9 @@ StageResult runStages(const Cloud& input, const ProcessingParams& params, Proces
 }
 
 std::string useScanBeam(ProcessingParams& params, const ScanRecord& record) {
-  OutlineParams& outline = params.analysis.outline;
-  if (outline.beam_exit_diameter_m != 0 || outline.beam_divergence_rad != 0) return {};
-  if (!record.cloud || !record.cloud->viewpoint) return {};
+  if (!record.cloud) return {};
   const std::optional<UnitConfig> unit = scanUnit(record);
-  if (!unit) return {};
-  useScannerBeam(outline, unit->model);
+  if (!unit || !useScannerBeamUnlessGiven(params.analysis.outline, unit->model, *record.cloud)) return {};
   return scannerModelName(unit->model);
 }
 
