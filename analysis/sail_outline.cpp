@@ -1407,9 +1407,9 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   if (mesh.triangles.empty()) throw InvalidInput("[extractOutline] empty mesh");
   checkOutlineParams(p);
   const bool beam_given = p.beamGiven();
-  const bool footprint = beam_given && scanner.has_value();
+  const bool footprint = beam_given && scanner.has_value() && !p.edges_against_sky;
   SailOutline out;
-  if (beam_given && !scanner)
+  if (beam_given && !scanner && !p.edges_against_sky)
     out.warnings.push_back("the beam's footprint is given but not where the scanner stood (the cloud has no viewpoint): "
                            "the edges are not moved out by it");
   const std::vector<uint32_t> loop_idx = outerBoundaryLoop(mesh);

@@ -36,6 +36,13 @@ struct OutlineParams {
   // (a cloud of unknown origin, or merged from several units).
   double beam_exit_diameter_m = 0;
   double beam_divergence_rad = 0;
+  // Nothing but open sky behind the sail's edges (a sail scanned on the water). A
+  // beam straddling an edge then has no background to mix with: it returns from
+  // the sail alone while enough of it lies there, and is lost beyond (the study,
+  // §4: no mixed pixels against the sky). The samples reach the edges, as far as
+  // the beam's axis, and the footprint moves nothing. Leave it false in a wind
+  // tunnel, where the walls lie behind, as they do in the built-in emulator's scene.
+  bool edges_against_sky = false;
   bool beamGiven() const { return beam_exit_diameter_m != 0 || beam_divergence_rad != 0; }
 };
 

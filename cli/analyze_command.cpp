@@ -24,7 +24,7 @@ struct AnalyzeOptions {
   std::vector<double> at;
   std::string plane;
   std::string json_out, mesh_out, params_file, cloud_out;
-  bool print_params = false, no_segment = false, quiet = false;
+  bool print_params = false, no_segment = false, quiet = false, sky = false;
   int corners = -1;
   std::string scanner;  // lms111 / lms511: its beam footprint for the edges
 };
@@ -86,6 +86,7 @@ void run(const AnalyzeOptions& o) {
   if (o.no_segment) params.segment = false;
   if (o.corners >= 0) params.outline.corners = o.corners;
   if (!o.scanner.empty()) useScannerBeam(params.outline, parseScannerModel(o.scanner));
+  if (o.sky) params.outline.edges_against_sky = true;
   if (o.print_params) {
     std::cout << paramsToJson(params).dump(2) << "\n";
     return;
@@ -140,8 +141,13 @@ void addAnalyzeCommand(CLI::App& app) {
                   "its whole beam footprint lies on it, so the samples stop short of every edge by the footprint's "
                   "reach (exit diameter/2 + range x divergence/2); the edges and corners are moved out by it. Needs "
                   "the scanner's position: the cloud's viewpoint (PLY/PCD header, as sailshape's scans write it). "
-                  "Sets outline.beam_exit_diameter_m and beam_divergence_rad (see --print-params)")
+                  "Sets outline.beam_exit_diameter_m and beam_divergence_rad (see --print-params). In a wind tunnel "
+                  "(walls behind the sail); for a scan on the water see --sky")
       ->check(CLI::IsMember({"lms111", "lms511"}, CLI::ignore_case));
+  cmd->add_flag("--sky", opt->sky,
+                "Nothing but open sky lies behind the sail's edges (a scan on the water): a beam straddling an edge "
+                "returns from the sail alone while enough of it lies there, so the samples reach the edges and "
+                "--scanner's footprint moves nothing. Sets outline.edges_against_sky");
   cmd->add_flag("--no-segment", opt->no_segment, "The input is the sail alone: skip segmentation");
   cmd->add_flag("--print-params", opt->print_params, "Print every pipeline parameter with its value and exit");
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress output");

@@ -982,6 +982,10 @@ void App::drawProcessing() {
           inputDouble("beam exit (m)", &ap.outline.beam_exit_diameter_m, 0.001, "%.4f");
           inputDouble("beam divergence (rad)", &ap.outline.beam_divergence_rad, 0.0005, "%.4f");
           helpMarker(beamHelp().c_str());
+          ImGui::Checkbox("edges against the sky", &ap.outline.edges_against_sky);
+          helpMarker("nothing but open sky behind the sail's edges (a scan on the water): a beam straddling an edge "
+                     "returns from the sail alone while enough of it lies there, so the samples reach the edges and "
+                     "the footprint moves nothing. Off in a wind tunnel, whose walls lie behind the sail");
           break;
       }
       ImGui::PopItemWidth();

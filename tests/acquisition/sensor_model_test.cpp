@@ -172,6 +172,49 @@ TEST(SensorModel, MixedPixelsAtASilhouetteEdge) {
   }
 }
 
+// The study's field test (§4): a target against the sky showed no mixed pixels; a
+// return comes back while enough of the spot lies on the target. A cloth panel at
+// 3 m with nothing behind it: a beam returns from the panel exactly while its axis
+// lies on it (the footprint's other half, in the sky, sends nothing back), and is
+// lost beyond. So a scan on the water reaches the sail's edges (OutlineParams::
+// edges_against_sky).
+TEST(SensorModel, AgainstTheSkyAnEdgeReturnsAsFarAsTheBeamsAxis) {
+  Scene s;
+  s.objects.push_back({"panel", Material::Cloth,
+                       makeQuad(Vec3(3, -3, -3), Vec3(3, 0, -3), Vec3(3, 0, 3), Vec3(3, -3, 3))});
+  SensorModelParams p;
+  p.model = ScannerModel::Lms111;  // the wider beam: 8 mm + 15 mrad · 3 m ≈ 5 cm across at the panel
+  p.noise_scale = 0;
+  const EmulatedSensor sensor(s, p);
+  ScanLineRequest r;
+  r.axis_x = Vec3(0, -1, 0);
+  r.axis_y = Vec3(1, 0, 0);
+  r.start_rad = 88 * kDeg;  // the edge is at 90° (y = 0)
+  r.step_rad = 0.02 * kDeg;
+  r.count = 201;
+  int on_panel = 0, straddling = 0;
+  const std::vector<BeamReturn> line = sensor.scanLine(r);
+  // The cloth's bias and the systematic error, read off the first beam (2° inside the edge).
+  ASSERT_EQ(line[0].status, ReturnStatus::Valid);
+  ASSERT_FALSE(line[0].mixed);
+  const double offset = line[0].range_m - 3.0 / std::sin(r.start_rad);
+  for (size_t i = 0; i < line.size(); ++i) {
+    if (i == 100) continue;  // the axis exactly on the edge
+    const double a = r.start_rad + r.step_rad * static_cast<double>(i);
+    const BeamReturn& b = line[i];
+    if (a < 90 * kDeg) {  // the axis (sin a, −cos a, 0) meets the panel's plane at y < 0
+      ASSERT_EQ(b.status, ReturnStatus::Valid) << "beam at " << a / kDeg << "°";
+      EXPECT_NEAR(b.range_m - offset, 3.0 / std::sin(a), 0.002) << "a straddling beam still reads the panel's range";
+      ++on_panel;
+      straddling += b.mixed;
+    } else {
+      EXPECT_NE(b.status, ReturnStatus::Valid) << "beam at " << a / kDeg << "°: nothing behind to return from";
+    }
+  }
+  EXPECT_EQ(on_panel, 100);
+  EXPECT_GE(straddling, 10) << "the footprint (≈ 5 cm, 0.1° wide) covers many 0.02° beams at the edge";
+}
+
 TEST(SensorModel, SunDazzleRaisesNoise) {
   SensorModelParams p;
   p.sun_direction = Vec3(1, 0, 0.05).normalized();

@@ -81,6 +81,35 @@ TEST(BeamFootprint, WithoutTheScannersPlaceTheEdgesStayAndAWarningSaysWhy) {
   EXPECT_TRUE(warned);
 }
 
+// Against the open sky a beam straddling an edge has nothing to mix with: it
+// returns from the sail while its axis lies there (SensorModel.
+// AgainstTheSkyAnEdgeReturnsAsFarAsTheBeamsAxis) and the samples reach the edges.
+// With edges_against_sky the beam moves nothing; without it, the footprint's
+// reach would be added to edges that were never trimmed.
+TEST(BeamFootprint, AgainstTheSkyTheSamplesReachTheEdgesAndNothingMoves) {
+  const Cloud cloud = test::scanWithFootprint(40000, 7, 0.0, 0.0);  // every sample on the sail kept
+  AnalysisParams p = sailOnly();
+  p.outline.beam_exit_diameter_m = kExit;
+  p.outline.beam_divergence_rad = kDivergence;
+  p.outline.edges_against_sky = true;
+  const SailAnalysis a = analyzeSail(cloud, p);
+  EXPECT_EQ(a.outline.footprint_reach_m, 0.0);
+  for (const std::string& w : a.outline.warnings) EXPECT_EQ(w.find("footprint"), std::string::npos) << w;
+  EXPECT_LT((a.outline.tack - kTack).norm(), 0.03);
+  EXPECT_LT((a.outline.clew - kClew).norm(), 0.03);
+  EXPECT_LT((a.outline.head - kHead).norm(), 0.03);
+  EXPECT_NEAR(a.outline.luff_length_m, luffLength(), 0.01);
+  EXPECT_NEAR(a.outline.leech_length_m, (kHead - kClew).norm(), 0.01);
+  EXPECT_NEAR(a.outline.foot_length_m, (kClew - kTack).norm(), 0.01);
+
+  // As if walls stood behind: every edge moved out by 2.5-3 cm, the 19° head far beyond the sail.
+  p.outline.edges_against_sky = false;
+  const SailAnalysis walls = analyzeSail(cloud, p);
+  EXPECT_GT(walls.outline.footprint_reach_m, 0.02);
+  EXPECT_GT((walls.outline.head - kHead).norm(), 0.10);
+  EXPECT_GT(walls.outline.luff_length_m, luffLength() + 0.05);
+}
+
 TEST(BeamFootprint, ABeamOutsideWhatAScannerHasIsRefused) {
   AnalysisParams p = sailOnly();
   p.outline.beam_divergence_rad = -0.001;

@@ -69,7 +69,7 @@ TEST_F(Cli, AnalyzeHelpMentionsEveryOption) {
   const Outcome r = sailshape("analyze --help");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   expectMentions(r.out, {"INPUT", "--sections", "--at", "--plane", "--json", "--mesh", "--sail-cloud", "--params",
-                         "--corners", "--scanner", "--no-segment", "--print-params", "-q", "--quiet"});
+                         "--corners", "--scanner", "--sky", "--no-segment", "--print-params", "-q", "--quiet"});
 }
 
 TEST_F(Cli, SimulateHelpMentionsEveryOption) {
@@ -147,7 +147,11 @@ TEST_F(Cli, PrintParamsShowsAParameterFileAndTheOptionsApplied) {
   const json beam = json::parse(named.out)["outline"];
   EXPECT_EQ(beam["beam_exit_diameter_m"], 0.013);
   EXPECT_EQ(beam["beam_divergence_rad"], 0.0047);
+  EXPECT_EQ(beam["edges_against_sky"], false) << "a tunnel's walls behind the edges unless --sky";
   EXPECT_EQ(sailshape("analyze --scanner lms200 --print-params").exit_code, 2);
+  const Outcome sky = sailshape("analyze --scanner lms511 --sky --print-params");
+  ASSERT_EQ(sky.exit_code, 0) << sky.err;
+  EXPECT_EQ(json::parse(sky.out)["outline"]["edges_against_sky"], true);
 }
 
 TEST_F(Cli, SimulatedMainIsMeasuredWithinHalfAPercentOfCamber) {
