@@ -142,8 +142,12 @@ with open(out + '.xyz', 'w') as fo:
                 fo.write('%.5f %.5f %.5f\n' % tuple(noisy(q)))
         L0, L1 = luff(0), luff(1)
         d = [L1[m] - L0[m] for m in range(3)]; nd = math.sqrt(sum(x * x for x in d))
-        fwd = [0, 0, 0]; c = (rm + gap) / 1.0
-        base = [L0[0] + c, L0[1], zdeck]; top = [L1[0] + c, L1[1], L1[2] + 0.5]
+        # parallel to the luff's chord, its surface `gap` ahead of it all the way: a pole from
+        # the deck straight up to above the head crossed a raked luff (a jib's, 14-22 deg)
+        # 15-20 cm aft of the tack, through the sail
+        c = rm + gap
+        def onLuffLine(z): return [L0[m] + d[m] * (z - L0[2]) / d[2] for m in range(3)]
+        base = onLuffLine(zdeck); top = onLuffLine(L1[2] + 0.5); base[0] += c; top[0] += c
         viewdir = [view[m] - (base[m] + top[m]) / 2 for m in range(3)]
         cyl(base, top, rm, int(dens * math.pi * rm * (top[2] - base[2])), viewdir)
         # boom: from the mast to past the clew, under the foot
