@@ -1131,6 +1131,13 @@ bool App::startLive() {
       options.analysis.sections.count = live_.sections;
       source = "no design: the Processing tab's ROI, flying values only";
     }
+    // The emulated deck stands in the open: only sky lies behind the main's leech and
+    // head, so a beam straddling them returns from the sail and the unit's footprint
+    // trims nothing there (OutlineParams::edges_against_sky).
+    if (all_deck && !sc.session.units().empty() && !options.analysis.outline.edges_against_sky) {
+      options.analysis.outline.edges_against_sky = true;
+      source += "; edges against the sky (the emulated deck)";
+    }
     params.design = std::move(design);
     params.scene = options;
     if (live_.save_each) {
