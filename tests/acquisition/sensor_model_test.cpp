@@ -132,20 +132,29 @@ TEST(SensorModel, RangeLimitsPerModel) {
   EXPECT_EQ(nothing.measure(Vec3::Zero(), -Vec3::UnitX(), rng).status, ReturnStatus::NoTarget);
 }
 
-TEST(SensorModel, MixedPixelsAtASilhouetteEdge) {
-  // A cloth panel at 3 m covering y < 0 in front of a wall at 6 m; LMS111 (15 mrad divergence).
-  Scene s = planeScene(Vec3(6, 0, 0), Vec3(-1, 0, 0), Material::Paint);
-  s.objects.push_back({"panel", Material::Cloth,
-                       makeQuad(Vec3(3, -3, -3), Vec3(3, 0, -3), Vec3(3, 0, 3), Vec3(3, -3, 3))});
-  SensorModelParams p;
-  p.model = ScannerModel::Lms111;
-  const EmulatedSensor sensor(s, p);
+// A cloth panel at 3 m covering y < 0 (its edge along z at y = 0), and a scan line
+// across that edge: 201 beams 0.02° apart from 88° (the edge at 90°).
+SceneObject edgePanel() {
+  return {"panel", Material::Cloth, makeQuad(Vec3(3, -3, -3), Vec3(3, 0, -3), Vec3(3, 0, 3), Vec3(3, -3, 3))};
+}
+ScanLineRequest acrossThePanelsEdge() {
   ScanLineRequest r;
   r.axis_x = Vec3(0, -1, 0);
   r.axis_y = Vec3(1, 0, 0);
-  r.start_rad = 88 * kDeg;  // the edge is at 90° (y = 0)
+  r.start_rad = 88 * kDeg;
   r.step_rad = 0.02 * kDeg;
   r.count = 201;
+  return r;
+}
+
+TEST(SensorModel, MixedPixelsAtASilhouetteEdge) {
+  // A cloth panel at 3 m covering y < 0 in front of a wall at 6 m; LMS111 (15 mrad divergence).
+  Scene s = planeScene(Vec3(6, 0, 0), Vec3(-1, 0, 0), Material::Paint);
+  s.objects.push_back(edgePanel());
+  SensorModelParams p;
+  p.model = ScannerModel::Lms111;
+  const EmulatedSensor sensor(s, p);
+  const ScanLineRequest r = acrossThePanelsEdge();
   const double tol = 6 * 0.0041 + 0.003 * 6;
   int mixed_between = 0;
   for (const BeamReturn& b : sensor.scanLine(r)) {
@@ -180,18 +189,12 @@ TEST(SensorModel, MixedPixelsAtASilhouetteEdge) {
 // edges_against_sky).
 TEST(SensorModel, AgainstTheSkyAnEdgeReturnsAsFarAsTheBeamsAxis) {
   Scene s;
-  s.objects.push_back({"panel", Material::Cloth,
-                       makeQuad(Vec3(3, -3, -3), Vec3(3, 0, -3), Vec3(3, 0, 3), Vec3(3, -3, 3))});
+  s.objects.push_back(edgePanel());
   SensorModelParams p;
   p.model = ScannerModel::Lms111;  // the wider beam: 8 mm + 15 mrad · 3 m ≈ 5 cm across at the panel
   p.noise_scale = 0;
   const EmulatedSensor sensor(s, p);
-  ScanLineRequest r;
-  r.axis_x = Vec3(0, -1, 0);
-  r.axis_y = Vec3(1, 0, 0);
-  r.start_rad = 88 * kDeg;  // the edge is at 90° (y = 0)
-  r.step_rad = 0.02 * kDeg;
-  r.count = 201;
+  const ScanLineRequest r = acrossThePanelsEdge();
   int on_panel = 0, straddling = 0;
   const std::vector<BeamReturn> line = sensor.scanLine(r);
   // The cloth's bias and the systematic error, read off the first beam (2° inside the edge).

@@ -32,6 +32,16 @@ AnalysisParams sailOnly() {
 
 double luffLength() { return (kHead - kTack).norm(); }
 
+// Issue 2's corner target on a clean scan, and the lengths to a centimetre.
+void expectTheTrueOutline(const SailOutline& o) {
+  EXPECT_LT((o.tack - kTack).norm(), 0.03);
+  EXPECT_LT((o.clew - kClew).norm(), 0.03);
+  EXPECT_LT((o.head - kHead).norm(), 0.03);
+  EXPECT_NEAR(o.luff_length_m, luffLength(), 0.01);
+  EXPECT_NEAR(o.leech_length_m, (kHead - kClew).norm(), 0.01);
+  EXPECT_NEAR(o.foot_length_m, (kClew - kTack).norm(), 0.01);
+}
+
 TEST(BeamFootprint, EdgesAndCornersComeBackOutToTheSailsTrueOutline) {
   const Cloud cloud = scanWithFootprint(40000, 7);
   // Uncorrected, the trimmed band (2.5-3 cm here) closes the 19° head far below it.
@@ -43,13 +53,7 @@ TEST(BeamFootprint, EdgesAndCornersComeBackOutToTheSailsTrueOutline) {
   p.outline.beam_exit_diameter_m = kExit;
   p.outline.beam_divergence_rad = kDivergence;
   const SailAnalysis a = analyzeSail(cloud, p);
-  // Issue 2's corner target on a clean scan, and the lengths to a centimetre.
-  EXPECT_LT((a.outline.tack - kTack).norm(), 0.03);
-  EXPECT_LT((a.outline.clew - kClew).norm(), 0.03);
-  EXPECT_LT((a.outline.head - kHead).norm(), 0.03);
-  EXPECT_NEAR(a.outline.luff_length_m, luffLength(), 0.01);
-  EXPECT_NEAR(a.outline.leech_length_m, (kHead - kClew).norm(), 0.01);
-  EXPECT_NEAR(a.outline.foot_length_m, (kClew - kTack).norm(), 0.01);
+  expectTheTrueOutline(a.outline);
   // The band round the whole sail holds reach × perimeter of area (0.65 m² here),
   // known to a quarter of that.
   const double area = 0.5 * (kHead - kTack).cross(kClew - kTack).norm();
@@ -95,12 +99,7 @@ TEST(BeamFootprint, AgainstTheSkyTheSamplesReachTheEdgesAndNothingMoves) {
   const SailAnalysis a = analyzeSail(cloud, p);
   EXPECT_EQ(a.outline.footprint_reach_m, 0.0);
   for (const std::string& w : a.outline.warnings) EXPECT_EQ(w.find("footprint"), std::string::npos) << w;
-  EXPECT_LT((a.outline.tack - kTack).norm(), 0.03);
-  EXPECT_LT((a.outline.clew - kClew).norm(), 0.03);
-  EXPECT_LT((a.outline.head - kHead).norm(), 0.03);
-  EXPECT_NEAR(a.outline.luff_length_m, luffLength(), 0.01);
-  EXPECT_NEAR(a.outline.leech_length_m, (kHead - kClew).norm(), 0.01);
-  EXPECT_NEAR(a.outline.foot_length_m, (kClew - kTack).norm(), 0.01);
+  expectTheTrueOutline(a.outline);
 
   // As if walls stood behind: every edge moved out by 2.5-3 cm, the 19° head far beyond the sail.
   p.outline.edges_against_sky = false;
