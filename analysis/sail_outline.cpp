@@ -691,6 +691,10 @@ struct CornerCurve {
   double sigma_at_corner = 0;  // m
   double from = 0, to = 0;     // the distances from the corner it was fitted over, m
   bool on_frontier = false;    // placed by the outermost samples beside it (ontoFrontier)
+  // How far the other frontier fits that fit their points as well put the corner
+  // sideways of this one (RMS), m: what choosing among them leaves unknown. Reported
+  // in the corner's uncertainty only; sigma_at_corner weighs the crossing (placeCorner).
+  double model_sigma = 0;
 };
 
 // The curve reaches max(60 boundary spacings, 5 % of the edge) from the corner.
@@ -858,10 +862,12 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
   std::vector<double> centre, delta;
   std::vector<double> depth(kFrontierDepthParts);
   std::vector<Vec3> frontier;
+  Vec3 first_in = Vec3::Zero();
   for (double dw = start + 0.5 * window; dw + 0.5 * window <= c.to + 1e-9 * window; dw += window) {
     const Vec3 p = c.curve.at(dw), t = c.curve.tangent(dw);
     const Across across_edge = acrossAt(p, p, t, smp, near, near_d2);
     const Vec3& in = across_edge.in;
+    if (centre.empty()) first_in = in;  // sideways at the corner's end
     stripDepths(other, dw, p, t, in, window, strip, depth);
     double D = 0, deepest = 0;
     for (double& part : depth) {
@@ -926,13 +932,25 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
     return k;
   };
   std::optional<Candidate> best;
+  std::vector<Vec3> fitting_corners;
   for (size_t m = centre.size();; m = std::max(kFewest, m * 4 / 5)) {
     for (int degree : {2, 3}) {
       if (m < 2 * static_cast<size_t>(degree + 1)) continue;
       const Candidate k = fitOver(m, degree);
+      if (k.fits) fitting_corners.push_back(k.curve.curve.at(0));
       if (!best || (k.fits && !best->fits) || (k.fits == best->fits && k.sigma < best->sigma)) best = k;
     }
     if (m == kFewest) break;
+  }
+  // The least-squares σ holds if the chosen polynomial is the edge's shape; the fits
+  // that do as well over more or fewer windows, or a degree higher, say how far that
+  // choice alone moves the corner. Without it clews of 40,000-point gennakers and
+  // jibs lay 1.7 of their σ off (RMS), with it 1.05-1.2 (bench/generator-sweep).
+  if (best->fits && fitting_corners.size() > 1) {
+    const Vec3 chosen = best->curve.curve.at(0);
+    double ss = 0;
+    for (const Vec3& q : fitting_corners) ss += std::pow((q - chosen).dot(first_in), 2);
+    best->curve.model_sigma = std::sqrt(ss / static_cast<double>(fitting_corners.size() - 1));
   }
   return best->curve;
 }
@@ -1008,6 +1026,9 @@ struct Meeting {
   // sideways uncertainty at the corner.
   Vec3 inward_a = Vec3::Zero(), inward_b = Vec3::Zero();
   double side_a_m = 0, side_b_m = 0;
+  // What the choice among equally fitting frontier curves leaves unknown (CornerCurve::
+  // model_sigma), along and across the bisector, at a wide corner: reported, not weighed.
+  double model_along_m = 0, model_across_m = 0;
 };
 
 // How far a corner curve turns over its first frontier window (from where it
@@ -1076,7 +1097,8 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
   };
   CornerCurve ca = cornerCurve(a, a_start, spacing, 2, false), cb = cornerCurve(b, b_start, spacing, 2, false);
   auto [sa, sb] = closest(ca, cb);
-  if (angleAt(ca, sa, cb, sb) >= kPi / 3.0) {
+  const bool wide = angleAt(ca, sa, cb, sb) >= kPi / 3.0;
+  if (wide) {
     constexpr double kFollowedTurnRad = 0.08;
     const CornerCurve whole_a = ca, whole_b = cb;  // unshortened: the frontier's reach
     ca = cornerCurve(a, a_start, spacing, 2, true);
@@ -1153,6 +1175,14 @@ Meeting meetEdges(const Edge& a, bool a_start, const Edge& b, bool b_start, doub
   }
   m.side_a_m = side_a;
   m.side_b_m = side_b;
+  // At a narrow corner that choice moves the crossing far along the bisector, where
+  // the outermost samples bound the corner anyway (placeCorner): there the added
+  // term put heads' σ at twice their errors (RMS), so it counts at wide corners only.
+  if (wide) {
+    const double model = std::hypot(ca.model_sigma, cb.model_sigma);
+    m.model_along_m = model / (2.0 * std::sin(half));
+    m.model_across_m = model / (2.0 * std::cos(std::min(half, 1.4)));
+  }
   return m;
 }
 
@@ -1593,7 +1623,8 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
     // bisector by (ε_a − ε_b) / (2 cos(angle / 2)).
     const double across = std::hypot(m.side_a_m, m.side_b_m) / (2.0 * std::cos(std::min(0.5 * m.angle_rad, 1.4)));
     const Vec3 shift = footprint ? footprintShift(p, *scanner, c.point, a, a_start, b, b_start, sp) : Vec3(Vec3::Zero());
-    spread = {std::hypot(c.sigma_m, kFootprintUncertainty * shift.norm()), across, 0.5 * m.angle_rad};
+    spread = {std::hypot(c.sigma_m, kFootprintUncertainty * shift.norm(), m.model_along_m),
+              std::hypot(across, m.model_across_m), 0.5 * m.angle_rad};
     return ontoSurface(Vec3(c.point + shift), mesh, tree, sp);
   };
   CornerSpread at_tack, at_clew, at_head, at_peak;

@@ -330,6 +330,24 @@ TEST(Pipeline, AWideCornersFrontierReachesIntoTheCorner) {
   }
 }
 
+// A clew's σ counts how far the frontier fits that fit their points as well as the
+// chosen one would put it: the least-squares σ alone assumes the chosen polynomial
+// is the edge's shape. Without it these clews lay 2.0 of their σ off (RMS); a σ
+// that says what it knows gives about 1, and over 8 corners the RMS spreads by
+// about 1/√16 of that, so 1.5 is two spreads above.
+TEST(Pipeline, AClewsUncertaintyCoversTheChoiceOfItsEdgesFit) {
+  const SailDesign design = exampleDesign(SailType::Jib);
+  const SailSurface truth(design);
+  double z2 = 0;
+  const std::vector<uint64_t> seeds{1, 2, 3, 4, 5, 6, 7, 8};
+  for (const uint64_t seed : seeds) {
+    const SailAnalysis a = analyzeSail(sampleSail(design, scan(40000, seed)));
+    ASSERT_GT(a.outline.uncertainty.clew_m, 0) << "seed " << seed;
+    z2 += std::pow((a.outline.clew - truth.clew()).norm() / a.outline.uncertainty.clew_m, 2);
+  }
+  EXPECT_LT(std::sqrt(z2 / static_cast<double>(seeds.size())), 1.5);
+}
+
 // On this seed the surface has a hole that touches the luff at one vertex; the
 // outline walked round it and named its far side the clew, 6.5 m from the real one.
 TEST(Pipeline, GennakerOutlineStaysOutOfAHoleThatTouchesItsLuff) {
