@@ -780,6 +780,12 @@ double frontierWindow(const CornerCurve& c, bool from_corner, double spacing) {
   return std::clamp((c.to - start) / kFrontierFewestWindows, spacing, kFrontierWindowSpacings * spacing);
 }
 
+// Which of `parts` equal parts of a window a point `along` from its centre falls in.
+size_t windowPart(double along, double window, size_t parts) {
+  const double f = std::clamp(along / window + 0.5, 0.0, 1.0);
+  return std::min(parts - 1, static_cast<size_t>(f * static_cast<double>(parts)));
+}
+
 // How deep a corner curve's strip reaches in at distance dw from the corner
 // (point p, tangent t, inward `in`), in each of `depth.size()` equal parts of a
 // window along it: `strip`, or half the sail's width there where that is less
@@ -791,9 +797,9 @@ void stripDepths(const CornerCurve& other, double dw, const Vec3& p, const Vec3&
   std::vector<double> across(parts, std::numeric_limits<double>::infinity());
   for (int i = 0; i <= 60; ++i) {
     const Vec3 q = other.curve.at(3.0 * dw * i / 60.0) - p;
-    const double along = q.dot(t) / window + 0.5;  // 0 to 1 within the window
-    if (along < 0 || along > 1) continue;
-    const size_t k = std::min(parts - 1, static_cast<size_t>(along * static_cast<double>(parts)));
+    const double along = q.dot(t);
+    if (std::abs(along) > 0.5 * window) continue;
+    const size_t k = windowPart(along, window, parts);
     across[k] = std::min(across[k], q.dot(in));
   }
   // A part the other curve's steps passed over lies between two that it crossed.
@@ -883,8 +889,7 @@ CornerCurve ontoFrontier(const CornerCurve& c, const CornerCurve& other, const S
       const double along = (smp.mesh.vertices[v] - p).dot(t);
       if (std::abs(along) > 0.5 * window) continue;
       const double o = (smp.mesh.vertices[v] - c.curve.at(dw + along)).dot(in);
-      const double part = (along / window + 0.5) * static_cast<double>(depth.size());
-      if (o > depth[std::min(depth.size() - 1, static_cast<size_t>(std::max(0.0, part)))] || o < -strip) continue;
+      if (o > depth[windowPart(along, window, depth.size())] || o < -strip) continue;
       least = std::min(least, o);
       ++n;
     }
