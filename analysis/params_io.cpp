@@ -10,6 +10,7 @@
 
 namespace sailshape {
 
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MixedPixelParams, jump_sigmas, max_incidence_deg, max_run_rad, max_missing)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(NormalParams, k_neighbours, orientation, robust)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegionGrowingParams, k_neighbours, max_normal_angle_deg, max_curvature,
                                                 min_points, max_points)
@@ -31,7 +32,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(OutlineParams, corners, corner_w
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions, plane, end_window, peak_window,
                                                 normal_tolerance_deg, max_tilt_deg, max_iterations, normal_radius,
                                                 noise_correlation_m, curve_points, max_bridged_gap)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, normals, segment,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, mixed_pixels, mixed, normals, segment,
                                                 segmentation_voxel_sigmas, working_voxel_sigmas, working_column_depth_sigmas,
                                                 working_voxel_of_extent, region_growing,
                                                 sail_pick, find_spars, spars, statistical_outliers, statistical, radius_outliers, radius,

@@ -162,6 +162,17 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
 
 }  // namespace
 
+MixedPixelParams mixedPixelParams(const AnalysisParams& p) {
+  MixedPixelParams m = p.mixed;
+  m.sensor_sigma_m = p.sensor_sigma_m;
+  return m;
+}
+
+Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p) {
+  if (!p.mixed_pixels || !scan.hasScanAngles() || !scan.viewpoint) return scan;
+  return selectPoints(scan, removeMixedPixels(scan, mixedPixelParams(p)).kept);
+}
+
 SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
   if (input.empty()) throw InvalidInput("[analyzeSail] empty cloud");
   for (size_t i = 0; i < input.size(); ++i)
@@ -185,9 +196,17 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     sp.sensor_sigma_m = p.sensor_sigma_m;
     checkSectionParams(sp);
   }
+  if (p.mixed_pixels) checkMixedPixelParams(mixedPixelParams(p));
   SailAnalysis a;
   a.points_in = input.size();
   Cloud cloud = input;
+
+  if (p.mixed_pixels && cloud.hasScanAngles() && cloud.viewpoint) {
+    StageTimer t(a, "mixed pixels", cloud.size());
+    const Cleaning c = removeMixedPixels(cloud, mixedPixelParams(p));
+    cloud = selectPoints(cloud, c.kept);
+    t.finish(cloud.size(), c.warnings);
+  }
 
   if (p.segment) {
     StageTimer t(a, "segmentation", cloud.size());

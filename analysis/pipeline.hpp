@@ -8,6 +8,7 @@
 #include "analysis/cloud.hpp"
 #include "analysis/luff_curve.hpp"
 #include "analysis/mesh.hpp"
+#include "analysis/mixed_pixels.hpp"
 #include "analysis/normals.hpp"
 #include "analysis/progress.hpp"
 #include "analysis/sail_outline.hpp"
@@ -21,6 +22,11 @@ namespace sailshape {
 
 struct AnalysisParams {
   double sensor_sigma_m = 0.004;   // SPEC §3; feeds smoothing classes and uncertainties
+  // A scan that carries its samples' scan angles and the scanner's position loses
+  // its mixed pixels first (analysis/mixed_pixels.hpp). Its sensor_sigma_m follows
+  // the one above.
+  bool mixed_pixels = true;
+  MixedPixelParams mixed;
   NormalParams normals;
   bool segment = true;             // false: the cloud is the sail alone, skip segmentation
   // Segmentation runs on a voxel-grid sample this many sensor σ wide when the
@@ -92,6 +98,13 @@ struct SailAnalysis {
 
 // Throws InvalidInput for an empty cloud or bad parameters, AnalysisError when
 // a stage cannot produce its result (no sail found, no boundary, ...).
+// p.mixed with p's sensor σ.
+MixedPixelParams mixedPixelParams(const AnalysisParams& p);
+// The scan less its mixed pixels (when it carries scan angles and a viewpoint and
+// p.mixed_pixels is set), for a crop to the sail before analyzeSail: they are
+// told by the surfaces on both sides of them, which the crop would cut off.
+Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p);
+
 SailAnalysis analyzeSail(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {});
 
 }  // namespace sailshape

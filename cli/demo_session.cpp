@@ -447,7 +447,10 @@ DemoResult runDemo(const DemoOptions& o, const DemoLog& log_fn, const Progress& 
           spars.push_back(f.spar);
         }
         const double max_x = u.roi_ends_at_mast ? spars.front().base.x() : 1e9;
-        const Cloud roi = cropToSail(boat_clouds[i], u.design_mesh, 0.1, 3 * ap.sensor_sigma_m, max_x, spars);
+        // The whole scan loses its mixed pixels before the crop cuts off the surfaces
+        // behind them (the main's head, seen against the A2, grew a fringe that put it 23 cm high).
+        const Cloud roi =
+            cropToSail(withoutMixedPixels(boat_clouds[i], ap), u.design_mesh, 0.1, 3 * ap.sensor_sigma_m, max_x, spars);
         writeCloud(cloud_dir + "/step" + std::to_string(step + 1) + "-" + u.sail_file + "-roi.ply", roi);
         try {
           analyses[i] = analyzeSail(roi, ap, progress);

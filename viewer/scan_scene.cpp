@@ -25,7 +25,8 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
     scene.raw_cloud = thinCloud(*record.cloud, options.max_cloud_points);
     if (options.analyze_cloud) {
       try {
-        scene.analysis = analyzeSail(cropToBox(*record.cloud, options.roi), options.analysis, progress);
+        scene.analysis = analyzeSail(cropToBox(withoutMixedPixels(*record.cloud, options.analysis), options.roi),
+                                     options.analysis, progress);
         scene.surface = scene.analysis->mesh;
       } catch (const Cancelled&) {
         throw;

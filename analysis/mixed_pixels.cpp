@@ -1,0 +1,224 @@
+#include "analysis/mixed_pixels.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "analysis/errors.hpp"
+
+namespace sailshape {
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+double medianOf(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// The scan's own grid: its lines (samples of one turn of the mirror, at one
+// turntable angle β give or take the turntable's drift during the turn) and each
+// sample's step along its line (α). Both are read off the angles alone, so the
+// cloud may come in any order.
+struct ScanGrid {
+  std::vector<std::vector<std::pair<int64_t, uint32_t>>> lines;  // per line: (α step, sample), by step
+  std::vector<int64_t> line_step;                                // per line: its place across the lines
+  double d_alpha = 0, d_beta = 0;                                // the angular steps, rad
+};
+
+ScanGrid scanGrid(const Cloud& c) {
+  ScanGrid g;
+  const size_t n = c.size();
+  std::vector<uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return c.beta_rad[a] < c.beta_rad[b]; });
+  // Within a line β moves on by the drift of one α step at most; between lines by
+  // about the whole line step. Most gaps are of the first kind.
+  std::vector<double> gaps;
+  gaps.reserve(n);
+  for (size_t i = 1; i < n; ++i) gaps.push_back(c.beta_rad[order[i]] - c.beta_rad[order[i - 1]]);
+  const double split = std::max(20.0 * medianOf(gaps), 1e-9);
+  std::vector<std::vector<uint32_t>> members(1);
+  for (size_t i = 0; i < n; ++i) {
+    if (i > 0 && gaps[i - 1] > split) members.emplace_back();
+    members.back().push_back(order[i]);
+  }
+  std::vector<double> alpha_steps, mean_beta;
+  for (std::vector<uint32_t>& m : members) {
+    std::sort(m.begin(), m.end(), [&](uint32_t a, uint32_t b) { return c.alpha_rad[a] < c.alpha_rad[b]; });
+    for (size_t i = 1; i < m.size(); ++i) {
+      const double d = c.alpha_rad[m[i]] - c.alpha_rad[m[i - 1]];
+      if (d > 1e-9) alpha_steps.push_back(d);
+    }
+    double b = 0;
+    for (uint32_t s : m) b += c.beta_rad[s];
+    mean_beta.push_back(b / static_cast<double>(m.size()));
+  }
+  g.d_alpha = medianOf(alpha_steps);
+  std::vector<double> beta_steps;
+  for (size_t i = 1; i < mean_beta.size(); ++i) beta_steps.push_back(mean_beta[i] - mean_beta[i - 1]);
+  g.d_beta = medianOf(beta_steps);
+  if (!(g.d_alpha > 0)) return g;
+  double alpha_min = c.alpha_rad[0];
+  for (double a : c.alpha_rad) alpha_min = std::min(alpha_min, a);
+  for (size_t l = 0; l < members.size(); ++l) {
+    std::vector<std::pair<int64_t, uint32_t>> line;
+    for (uint32_t s : members[l]) {
+      const int64_t k = std::llround((c.alpha_rad[s] - alpha_min) / g.d_alpha);
+      if (line.empty() || line.back().first != k) line.emplace_back(k, s);  // a second echo at one step stays off the grid
+    }
+    g.lines.push_back(std::move(line));
+    g.line_step.push_back(g.d_beta > 0 ? std::llround((mean_beta[l] - mean_beta[0]) / g.d_beta) : 0);
+  }
+  return g;
+}
+
+// One row of the grid (along a line, or across the lines at one α step): `pos` the
+// samples' places along it, ascending; `delta` its angular step. Marks in `mixed`
+// the short runs between two edges stepping the same way.
+void markRow(const std::vector<int64_t>& pos, const std::vector<uint32_t>& sample, double delta,
+             const std::vector<double>& range, const MixedPixelParams& p, std::vector<char>& mixed) {
+  const size_t m = pos.size();
+  const double second = p.jump_sigmas * std::sqrt(6.0) * p.sensor_sigma_m;
+  const double first = p.jump_sigmas * std::sqrt(2.0) * p.sensor_sigma_m;
+  const double steepest = std::tan(p.max_incidence_deg * kDeg);
+  std::vector<double> dr;
+  std::vector<int64_t> steps;
+  std::vector<char> edge;
+  for (size_t a = 0; a < m;) {
+    // A chain: samples no more than max_missing apart.
+    size_t b = a;
+    while (b + 1 < m && pos[b + 1] - pos[b] <= p.max_missing + 1) ++b;
+    if (b - a >= 2) {
+      const size_t pairs = b - a;
+      dr.assign(pairs, 0);
+      steps.assign(pairs, 1);
+      edge.assign(pairs, 0);
+      for (size_t j = 0; j < pairs; ++j) {
+        dr[j] = range[sample[a + j + 1]] - range[sample[a + j]];
+        steps[j] = pos[a + j + 1] - pos[a + j];
+      }
+      // A step larger than noise (5 σ of a difference) belongs to a stretch of such
+      // steps the same way. A short one (no wider than a transition across an edge)
+      // is measured against the slopes beyond it, so that a transition stepping
+      // evenly through several mixed samples still shows; a longer one is a steep
+      // surface, and each step is measured against its neighbours.
+      auto big = [&](size_t j) { return std::abs(dr[j]) > first; };
+      for (size_t j = 0; j < pairs; ++j) {
+        const double st = static_cast<double>(steps[j]);
+        if (std::abs(dr[j]) > st * range[sample[a + j]] * delta * steepest + first) {
+          edge[j] = 1;
+          continue;
+        }
+        if (!big(j)) continue;
+        size_t s0 = j, s1 = j;
+        while (s0 > 0 && big(s0 - 1) && (dr[s0 - 1] > 0) == (dr[j] > 0)) --s0;
+        while (s1 + 1 < pairs && big(s1 + 1) && (dr[s1 + 1] > 0) == (dr[j] > 0)) ++s1;
+        const double span = static_cast<double>(pos[a + s1 + 1] - pos[a + s0]) * delta;
+        const bool transition = span <= p.max_run_rad + delta;
+        const bool has_prev = transition ? s0 > 0 : j > 0;
+        const bool has_next = transition ? s1 + 1 < pairs : j + 1 < pairs;
+        const size_t prev = transition ? s0 - 1 : j - 1, next = transition ? s1 + 1 : j + 1;
+        auto offSlope = [&](size_t k) { return std::abs(dr[j] - dr[k] / static_cast<double>(steps[k]) * st) > second; };
+        edge[j] = (has_prev || has_next) && (!has_prev || offSlope(prev)) && (!has_next || offSlope(next));
+      }
+      // Runs of samples between edges: run [u, v] (chain indices) has edge u-1 before it and edge v after it.
+      size_t u = 0;
+      for (size_t j = 0; j < pairs; ++j) {
+        if (!edge[j]) continue;
+        if (u > 0) {
+          const size_t v = j;
+          const bool same_way = (dr[u - 1] > 0) == (dr[v] > 0);
+          const double width = static_cast<double>(pos[a + v] - pos[a + u] + 1) * delta;
+          if (same_way && width <= p.max_run_rad)
+            for (size_t k = u; k <= v; ++k) mixed[sample[a + k]] = 1;
+        }
+        u = j + 1;
+      }
+    }
+    a = b + 1;
+  }
+}
+
+}  // namespace
+
+void checkMixedPixelParams(const MixedPixelParams& p) {
+  auto bad = [](const std::string& what) { throw InvalidInput("[removeMixedPixels] " + what); };
+  if (!(p.sensor_sigma_m > 0) || !std::isfinite(p.sensor_sigma_m))
+    bad("sensor_sigma_m must be > 0 (got " + std::to_string(p.sensor_sigma_m) + ")");
+  if (!(p.jump_sigmas > 0) || !std::isfinite(p.jump_sigmas))
+    bad("jump_sigmas must be > 0 (got " + std::to_string(p.jump_sigmas) + ")");
+  if (!(p.max_incidence_deg > 0 && p.max_incidence_deg < 90))
+    bad("max_incidence_deg must be in (0, 90) (got " + std::to_string(p.max_incidence_deg) + ")");
+  if (!(p.max_run_rad > 0) || !std::isfinite(p.max_run_rad))
+    bad("max_run_rad must be > 0 (got " + std::to_string(p.max_run_rad) + ")");
+  if (p.max_missing < 0) bad("max_missing must be >= 0 (got " + std::to_string(p.max_missing) + ")");
+}
+
+Cleaning removeMixedPixels(const Cloud& cloud, const MixedPixelParams& params) {
+  checkMixedPixelParams(params);
+  Cleaning out;
+  out.kept.resize(cloud.size());
+  std::iota(out.kept.begin(), out.kept.end(), 0u);
+  if (!cloud.hasScanAngles() || !cloud.viewpoint) {
+    out.warnings.push_back(std::string("mixed pixels not looked for: the cloud has no ") +
+                           (cloud.hasScanAngles() ? "viewpoint (scanner position)" : "scan angles (alpha, beta)"));
+    return out;
+  }
+  if (cloud.alpha_rad.size() != cloud.size() || cloud.beta_rad.size() != cloud.size())
+    throw InvalidInput("[removeMixedPixels] the cloud has " + std::to_string(cloud.size()) + " points but " +
+                       std::to_string(cloud.alpha_rad.size()) + " alpha and " + std::to_string(cloud.beta_rad.size()) +
+                       " beta angles");
+  for (size_t i = 0; i < cloud.size(); ++i)
+    if (!std::isfinite(cloud.alpha_rad[i]) || !std::isfinite(cloud.beta_rad[i]))
+      throw InvalidInput("[removeMixedPixels] point " + std::to_string(i) + " has a non-finite scan angle");
+  out.threshold_m = params.jump_sigmas * std::sqrt(6.0) * params.sensor_sigma_m;
+  if (cloud.size() < 3) return out;
+
+  std::vector<double> range(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) range[i] = (cloud.points[i] - *cloud.viewpoint).norm();
+  const ScanGrid grid = scanGrid(cloud);
+  if (!(grid.d_alpha > 0)) return out;
+
+  std::vector<char> mixed(cloud.size(), 0);
+  std::vector<int64_t> pos;
+  std::vector<uint32_t> sample;
+  for (const auto& line : grid.lines) {  // along each line
+    pos.clear();
+    sample.clear();
+    for (const auto& [k, s] : line) {
+      pos.push_back(k);
+      sample.push_back(s);
+    }
+    markRow(pos, sample, grid.d_alpha, range, params, mixed);
+  }
+  if (grid.d_beta > 0) {  // across the lines, at each α step
+    std::unordered_map<int64_t, std::vector<std::pair<int64_t, uint32_t>>> columns;
+    for (size_t l = 0; l < grid.lines.size(); ++l)
+      for (const auto& [k, s] : grid.lines[l]) columns[k].emplace_back(grid.line_step[l], s);
+    for (auto& [k, column] : columns) {
+      std::sort(column.begin(), column.end());
+      pos.clear();
+      sample.clear();
+      for (const auto& [l, s] : column) {
+        if (!pos.empty() && pos.back() == l) continue;  // two lines at one place: the first stands for it
+        pos.push_back(l);
+        sample.push_back(s);
+      }
+      markRow(pos, sample, grid.d_beta, range, params, mixed);
+    }
+  }
+  out.kept.clear();
+  for (uint32_t i = 0; i < cloud.size(); ++i) (mixed[i] ? out.removed : out.kept).push_back(i);
+  return out;
+}
+
+}  // namespace sailshape
