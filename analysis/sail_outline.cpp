@@ -1238,6 +1238,15 @@ std::optional<HeightField> heightFieldAround(const Vec3& c, const Mesh& mesh, co
   return f;
 }
 
+// The direction from `corner` to the point a tenth of edge e's length along it
+// (from its start when at_start, else from its end): how the sail's samples open
+// from a corner, which the corner curves' own tangents where they meet, extrapolated
+// past the samples, may not show (they can close in to parallel).
+Vec3 edgeChord(const Edge& e, bool at_start, const Vec3& corner, double spacing) {
+  const double l = std::clamp(0.1 * e.length, std::min(e.exclude + spacing, 0.5 * e.length), 0.5 * e.length);
+  return Vec3(e.curve.at(at_start ? l : e.length - l) - corner).normalized();
+}
+
 // At a narrow corner (the head of most sails) the crossing of the two edges is
 // poorly placed along the bisector, while the samples say where the sail at least
 // reaches: the corner lies at or beyond the outermost sample, and a wedge of
@@ -1250,7 +1259,7 @@ struct PlacedCorner {
   double sigma_m = 0;  // 1σ along the bisector
 };
 PlacedCorner placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tree, const std::vector<Vec3>& loose,
-                         double density, double reach, double spacing) {
+                         double density, double reach, double spacing, double chord_angle_rad) {
   if (m.outward.isZero() || !(density > 0) || !(m.sigma_along_m > 0)) return {m.point, m.sigma_along_m};
   std::vector<uint32_t> idx;
   std::vector<double> d2;
@@ -1283,9 +1292,12 @@ PlacedCorner placeCorner(const Meeting& m, const Mesh& mesh, const PointGrid& tr
       if (inside && on_surface) extreme = std::max(extreme, d.dot(m.outward));
     }
   }
+  // The wedge opens at least as the edges' chords from the crossing do: a tunnel
+  // main's corner curves met parallel at its 20° head (the tangents' angle 0.1°),
+  // which left the tip's gap unbounded and put the head 24 cm beyond its samples.
   // (Edges parallel to the last bit still leave a wedge: the half angle is floored
   // as meetEdges floors it, so that λ > 0.)
-  const double lambda = density * std::tan(std::clamp(0.5 * m.angle_rad, 1e-3, 1.4));
+  const double lambda = density * std::tan(std::clamp(0.5 * std::max(m.angle_rad, chord_angle_rad), 1e-3, 1.4));
   const double gap_scale = 1.0 / std::sqrt(lambda);  // typical empty tip length, m
   const double s = m.sigma_along_m;
   // A crossing many of its σ and of the tip's gaps beyond every sample comes from
@@ -1378,11 +1390,7 @@ double footprintReach(const OutlineParams& p, const Vec3& origin, const Vec3& at
 // head met at 3.7°, which moved it 67 cm). Zero where the edges are parallel.
 Vec3 footprintShift(const OutlineParams& p, const Vec3& scanner, const Vec3& corner, const Edge& a, bool a_start,
                     const Edge& b, bool b_start, double spacing) {
-  auto chord = [&](const Edge& e, bool at_start) {
-    const double l = std::clamp(0.1 * e.length, std::min(e.exclude + spacing, 0.5 * e.length), 0.5 * e.length);
-    return Vec3(e.curve.at(at_start ? l : e.length - l) - corner).normalized();
-  };
-  const Vec3 ta = chord(a, a_start), tb = chord(b, b_start);
+  const Vec3 ta = edgeChord(a, a_start, corner, spacing), tb = edgeChord(b, b_start, corner, spacing);
   const Vec3 across_a = tb - tb.dot(ta) * ta, across_b = ta - ta.dot(tb) * tb;
   const Vec3 plane_normal = ta.cross(tb);
   if (!(plane_normal.norm() > 1e-3 && across_a.norm() > 1e-6 && across_b.norm() > 1e-6)) return Vec3::Zero();
@@ -1623,7 +1631,9 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   };
   auto corner = [&](const Edge& a, bool a_start, const Edge& b, bool b_start, CornerSpread& spread) {
     const Meeting m = meetEdges(a, a_start, b, b_start, sp, samples);
-    const PlacedCorner c = placeCorner(m, mesh, tree, loose_points, density, reach, sp);
+    const double chord_angle =
+        std::acos(std::clamp(edgeChord(a, a_start, m.point, sp).dot(edgeChord(b, b_start, m.point, sp)), -1.0, 1.0));
+    const PlacedCorner c = placeCorner(m, mesh, tree, loose_points, density, reach, sp, chord_angle);
     // Moving the two edges sideways by ε_a and ε_b moves their crossing across the
     // bisector by (ε_a − ε_b) / (2 cos(angle / 2)).
     const double across = std::hypot(m.side_a_m, m.side_b_m) / (2.0 * std::cos(std::min(0.5 * m.angle_rad, 1.4)));
