@@ -155,7 +155,12 @@ Acquisition ScannerSession::scan(const SweepOptions& options, const Progress& pr
   for (Sweep& s : a.sweeps) {
     if (s.partial) a.warnings.push_back(s.unit + ": partial sweep (" + s.message + ")");
     for (const auto& w : s.warnings) a.warnings.push_back(s.unit + ": " + w);
-    a.cloud.points.insert(a.cloud.points.end(), s.cloud.points.begin(), s.cloud.points.end());
+    // One unit's sweep keeps its samples' scan angles: its mixed pixels are found on
+    // its grid (analysis/mixed_pixels.hpp). Several units' samples share no grid.
+    if (a.sweeps.size() == 1)
+      a.cloud = std::move(s.cloud);
+    else
+      a.cloud.points.insert(a.cloud.points.end(), s.cloud.points.begin(), s.cloud.points.end());
     s.cloud = Cloud{};
     s.points.clear();
     s.points.shrink_to_fit();

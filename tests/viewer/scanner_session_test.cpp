@@ -113,6 +113,12 @@ TEST(ScannerSession, TheDeckUnitSeesTheMainsail) {
   for (const Vec3& p : a.cloud.points)
     if (std::abs(sail.signedDistance(p)) < 5 * kSigmaCloth) ++on_sail;
   EXPECT_GT(on_sail, a.cloud.size() / 5) << on_sail << " of " << a.cloud.size();
+  // One unit's sweep keeps where it stood and each sample's scan angles, which its
+  // mixed pixels are found by.
+  ASSERT_TRUE(a.cloud.viewpoint.has_value());
+  ASSERT_TRUE(a.cloud.hasScanAngles());
+  EXPECT_EQ(a.cloud.alpha_rad.size(), a.cloud.size());
+  EXPECT_EQ(a.cloud.beta_rad.size(), a.cloud.size());
 }
 
 TEST(ScannerSession, TheCloudArrivesWhileTheUnitsSweep) {
