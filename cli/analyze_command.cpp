@@ -119,7 +119,9 @@ void addAnalyzeCommand(CLI::App& app) {
       "analyze",
       "Analyse a cloud of a flying sail (alone or in a scene with mast, boom and deck, in the boat frame): "
       "segment it, clean and smooth it, build its surface, find corners and edges, and cut sections with "
-      "camber, draft, twist, entry and exit angles, each with its uncertainty.");
+      "camber, draft, twist, entry and exit angles, each with its uncertainty. A scan that carries its samples' "
+      "scan angles and the scanner's position (sailshape's own) first loses its mixed pixels (a beam straddling "
+      "an edge returns a range between the sail and what lies behind it); see mixed_pixels in --print-params.");
   cmd->add_option("INPUT", opt->input, "Cloud file: .ply (ascii/binary), .pcd, .xyz/.txt or .csv, metres");
   cmd->add_option("--sections", opt->sections, "Number of sections N, at t = k/(N+1) of luff and leech (default 3)")
       ->check(CLI::Range(1, 100));
