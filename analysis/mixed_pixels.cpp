@@ -93,6 +93,7 @@ void markRow(const std::vector<int64_t>& pos, const std::vector<uint32_t>& sampl
   std::vector<double> dr;
   std::vector<int64_t> steps;
   std::vector<char> edge;
+  std::vector<size_t> stretch_from, stretch_to;  // per pair: the stretch of large steps the same way it is in
   for (size_t a = 0; a < m;) {
     // A chain: samples no more than max_missing apart.
     size_t b = a;
@@ -112,6 +113,18 @@ void markRow(const std::vector<int64_t>& pos, const std::vector<uint32_t>& sampl
       // evenly through several mixed samples still shows; a longer one is a steep
       // surface, and each step is measured against its neighbours.
       auto big = [&](size_t j) { return std::abs(dr[j]) > first; };
+      stretch_from.assign(pairs, 0);
+      stretch_to.assign(pairs, 0);
+      for (size_t j = 0; j < pairs;) {
+        size_t e = j;
+        if (big(j))
+          while (e + 1 < pairs && big(e + 1) && (dr[e + 1] > 0) == (dr[j] > 0)) ++e;
+        for (size_t k = j; k <= e; ++k) {
+          stretch_from[k] = j;
+          stretch_to[k] = e;
+        }
+        j = e + 1;
+      }
       for (size_t j = 0; j < pairs; ++j) {
         const double st = static_cast<double>(steps[j]);
         if (std::abs(dr[j]) > st * range[sample[a + j]] * delta * steepest + first) {
@@ -119,9 +132,7 @@ void markRow(const std::vector<int64_t>& pos, const std::vector<uint32_t>& sampl
           continue;
         }
         if (!big(j)) continue;
-        size_t s0 = j, s1 = j;
-        while (s0 > 0 && big(s0 - 1) && (dr[s0 - 1] > 0) == (dr[j] > 0)) --s0;
-        while (s1 + 1 < pairs && big(s1 + 1) && (dr[s1 + 1] > 0) == (dr[j] > 0)) ++s1;
+        const size_t s0 = stretch_from[j], s1 = stretch_to[j];
         const double span = static_cast<double>(pos[a + s1 + 1] - pos[a + s0]) * delta;
         const bool transition = span <= p.max_run_rad + delta;
         const bool has_prev = transition ? s0 > 0 : j > 0;
