@@ -24,14 +24,18 @@ double medianOf(std::vector<double> v) {
   return *mid;
 }
 
+// A row of the grid (along a line, or across the lines at one α step): its samples
+// as (place along the row, sample), by place, one sample a place.
+using Row = std::vector<std::pair<int64_t, uint32_t>>;
+
 // The scan's own grid: its lines (samples of one turn of the mirror, at one
 // turntable angle β give or take the turntable's drift during the turn) and each
 // sample's step along its line (α). Both are read off the angles alone, so the
 // cloud may come in any order.
 struct ScanGrid {
-  std::vector<std::vector<std::pair<int64_t, uint32_t>>> lines;  // per line: (α step, sample), by step
-  std::vector<int64_t> line_step;                                // per line: its place across the lines
-  double d_alpha = 0, d_beta = 0;                                // the angular steps, rad
+  std::vector<Row> lines;           // per line: its samples by α step
+  std::vector<int64_t> line_step;   // per line: its place across the lines
+  double d_alpha = 0, d_beta = 0;   // the angular steps, rad
 };
 
 ScanGrid scanGrid(const Cloud& c) {
@@ -70,7 +74,7 @@ ScanGrid scanGrid(const Cloud& c) {
   double alpha_min = c.alpha_rad[0];
   for (double a : c.alpha_rad) alpha_min = std::min(alpha_min, a);
   for (size_t l = 0; l < members.size(); ++l) {
-    std::vector<std::pair<int64_t, uint32_t>> line;
+    Row line;
     for (uint32_t s : members[l]) {
       const int64_t k = std::llround((c.alpha_rad[s] - alpha_min) / g.d_alpha);
       if (line.empty() || line.back().first != k) line.emplace_back(k, s);  // a second echo at one step stays off the grid
@@ -81,12 +85,13 @@ ScanGrid scanGrid(const Cloud& c) {
   return g;
 }
 
-// One row of the grid (along a line, or across the lines at one α step): `pos` the
-// samples' places along it, ascending; `delta` its angular step. Marks in `mixed`
-// the short runs between two edges stepping the same way.
-void markRow(const std::vector<int64_t>& pos, const std::vector<uint32_t>& sample, double delta,
-             const std::vector<double>& range, const MixedPixelParams& p, std::vector<char>& mixed) {
-  const size_t m = pos.size();
+// Marks in `mixed` the short runs of `row` between two edges stepping the same way;
+// `delta` is the row's angular step.
+void markRow(const Row& row, double delta, const std::vector<double>& range, const MixedPixelParams& p,
+             std::vector<char>& mixed) {
+  const size_t m = row.size();
+  auto pos = [&](size_t i) { return row[i].first; };
+  auto sample = [&](size_t i) { return row[i].second; };
   const double second = p.jump_sigmas * std::sqrt(6.0) * p.sensor_sigma_m;
   const double first = p.jump_sigmas * std::sqrt(2.0) * p.sensor_sigma_m;
   const double steepest = std::tan(p.max_incidence_deg * kDeg);
@@ -97,15 +102,15 @@ void markRow(const std::vector<int64_t>& pos, const std::vector<uint32_t>& sampl
   for (size_t a = 0; a < m;) {
     // A chain: samples no more than max_missing apart.
     size_t b = a;
-    while (b + 1 < m && pos[b + 1] - pos[b] <= p.max_missing + 1) ++b;
+    while (b + 1 < m && pos(b + 1) - pos(b) <= p.max_missing + 1) ++b;
     if (b - a >= 2) {
       const size_t pairs = b - a;
       dr.assign(pairs, 0);
       steps.assign(pairs, 1);
       edge.assign(pairs, 0);
       for (size_t j = 0; j < pairs; ++j) {
-        dr[j] = range[sample[a + j + 1]] - range[sample[a + j]];
-        steps[j] = pos[a + j + 1] - pos[a + j];
+        dr[j] = range[sample(a + j + 1)] - range[sample(a + j)];
+        steps[j] = pos(a + j + 1) - pos(a + j);
       }
       // A step larger than noise (5 σ of a difference) belongs to a stretch of such
       // steps the same way. A short one (no wider than a transition across an edge)
@@ -127,13 +132,13 @@ void markRow(const std::vector<int64_t>& pos, const std::vector<uint32_t>& sampl
       }
       for (size_t j = 0; j < pairs; ++j) {
         const double st = static_cast<double>(steps[j]);
-        if (std::abs(dr[j]) > st * range[sample[a + j]] * delta * steepest + first) {
+        if (std::abs(dr[j]) > st * range[sample(a + j)] * delta * steepest + first) {
           edge[j] = 1;
           continue;
         }
         if (!big(j)) continue;
         const size_t s0 = stretch_from[j], s1 = stretch_to[j];
-        const double span = static_cast<double>(pos[a + s1 + 1] - pos[a + s0]) * delta;
+        const double span = static_cast<double>(pos(a + s1 + 1) - pos(a + s0)) * delta;
         const bool transition = span <= p.max_run_rad + delta;
         const bool has_prev = transition ? s0 > 0 : j > 0;
         const bool has_next = transition ? s1 + 1 < pairs : j + 1 < pairs;
@@ -148,9 +153,9 @@ void markRow(const std::vector<int64_t>& pos, const std::vector<uint32_t>& sampl
         if (u > 0) {
           const size_t v = j;
           const bool same_way = (dr[u - 1] > 0) == (dr[v] > 0);
-          const double width = static_cast<double>(pos[a + v] - pos[a + u] + 1) * delta;
+          const double width = static_cast<double>(pos(a + v) - pos(a + u) + 1) * delta;
           if (same_way && width <= p.max_run_rad)
-            for (size_t k = u; k <= v; ++k) mixed[sample[a + k]] = 1;
+            for (size_t k = u; k <= v; ++k) mixed[sample(a + k)] = 1;
         }
         u = j + 1;
       }
@@ -200,31 +205,17 @@ Cleaning removeMixedPixels(const Cloud& cloud, const MixedPixelParams& params) {
   if (!(grid.d_alpha > 0)) return out;
 
   std::vector<char> mixed(cloud.size(), 0);
-  std::vector<int64_t> pos;
-  std::vector<uint32_t> sample;
-  for (const auto& line : grid.lines) {  // along each line
-    pos.clear();
-    sample.clear();
-    for (const auto& [k, s] : line) {
-      pos.push_back(k);
-      sample.push_back(s);
-    }
-    markRow(pos, sample, grid.d_alpha, range, params, mixed);
-  }
+  for (const Row& line : grid.lines) markRow(line, grid.d_alpha, range, params, mixed);  // along each line
   if (grid.d_beta > 0) {  // across the lines, at each α step
-    std::unordered_map<int64_t, std::vector<std::pair<int64_t, uint32_t>>> columns;
+    std::unordered_map<int64_t, Row> columns;
     for (size_t l = 0; l < grid.lines.size(); ++l)
       for (const auto& [k, s] : grid.lines[l]) columns[k].emplace_back(grid.line_step[l], s);
     for (auto& [k, column] : columns) {
       std::sort(column.begin(), column.end());
-      pos.clear();
-      sample.clear();
-      for (const auto& [l, s] : column) {
-        if (!pos.empty() && pos.back() == l) continue;  // two lines at one place: the first stands for it
-        pos.push_back(l);
-        sample.push_back(s);
-      }
-      markRow(pos, sample, grid.d_beta, range, params, mixed);
+      // Two lines at one place: the first stands for it.
+      column.erase(std::unique(column.begin(), column.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+                   column.end());
+      markRow(column, grid.d_beta, range, params, mixed);
     }
   }
   out.kept.clear();

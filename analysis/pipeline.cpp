@@ -168,8 +168,15 @@ MixedPixelParams mixedPixelParams(const AnalysisParams& p) {
   return m;
 }
 
+namespace {
+// Whether the analysis looks for mixed pixels in `scan`: only a scan's own grid shows them.
+bool looksForMixedPixels(const Cloud& scan, const AnalysisParams& p) {
+  return p.mixed_pixels && scan.hasScanAngles() && scan.viewpoint;
+}
+}  // namespace
+
 Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p) {
-  if (!p.mixed_pixels || !scan.hasScanAngles() || !scan.viewpoint) return scan;
+  if (!looksForMixedPixels(scan, p)) return scan;
   return selectPoints(scan, removeMixedPixels(scan, mixedPixelParams(p)).kept);
 }
 
@@ -201,7 +208,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
   a.points_in = input.size();
   Cloud cloud = input;
 
-  if (p.mixed_pixels && cloud.hasScanAngles() && cloud.viewpoint) {
+  if (looksForMixedPixels(cloud, p)) {
     StageTimer t(a, "mixed pixels", cloud.size());
     const Cleaning c = removeMixedPixels(cloud, mixedPixelParams(p));
     cloud = selectPoints(cloud, c.kept);

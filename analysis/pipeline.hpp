@@ -96,8 +96,6 @@ struct SailAnalysis {
   std::vector<std::string> warnings; // every stage's warnings, prefixed by stage
 };
 
-// Throws InvalidInput for an empty cloud or bad parameters, AnalysisError when
-// a stage cannot produce its result (no sail found, no boundary, ...).
 // p.mixed with p's sensor σ.
 MixedPixelParams mixedPixelParams(const AnalysisParams& p);
 // The scan less its mixed pixels (when it carries scan angles and a viewpoint and
@@ -105,6 +103,8 @@ MixedPixelParams mixedPixelParams(const AnalysisParams& p);
 // told by the surfaces on both sides of them, which the crop would cut off.
 Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p);
 
+// Throws InvalidInput for an empty cloud or bad parameters, AnalysisError when
+// a stage cannot produce its result (no sail found, no boundary, ...).
 SailAnalysis analyzeSail(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {});
 
 }  // namespace sailshape

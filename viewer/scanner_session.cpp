@@ -140,7 +140,6 @@ Acquisition ScannerSession::scan(const SweepOptions& options, const Progress& pr
   if (units_.size() == 1) {
     a.sweeps.push_back(runSweep(units_[0].config, options, progress));
     a.errors.push_back("");
-    a.cloud.viewpoint = a.sweeps.front().cloud.viewpoint;
     a.model = units_[0].config.model;
   } else {
     std::vector<UnitConfig> configs;
@@ -155,8 +154,9 @@ Acquisition ScannerSession::scan(const SweepOptions& options, const Progress& pr
   for (Sweep& s : a.sweeps) {
     if (s.partial) a.warnings.push_back(s.unit + ": partial sweep (" + s.message + ")");
     for (const auto& w : s.warnings) a.warnings.push_back(s.unit + ": " + w);
-    // One unit's sweep keeps its samples' scan angles: its mixed pixels are found on
-    // its grid (analysis/mixed_pixels.hpp). Several units' samples share no grid.
+    // One unit's sweep keeps where it stood and its samples' scan angles: its mixed
+    // pixels are found on its grid (analysis/mixed_pixels.hpp). Several units'
+    // samples share neither.
     if (a.sweeps.size() == 1)
       a.cloud = std::move(s.cloud);
     else

@@ -148,11 +148,10 @@ TEST_F(DemoRun, TheMainsTackAndHeadStandWhereTheSailFlies) {
   while (st.step()) {
     ++analyses;
     const nlohmann::json sail = nlohmann::json::parse(st.columnText(0));
-    for (const char* corner : {"tack", "head"}) {
+    for (const auto& [corner, want] : {std::pair<std::string, sailshape::Vec3>{"tack", truth.tack()}, {"head", truth.head()}}) {
       const auto& c = sail.at(corner);
       const sailshape::Vec3 at(c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<double>());
-      const double sigma = sail.at("uncertainty").at(std::string(corner) + "_m").get<double>();
-      const sailshape::Vec3 want = std::string(corner) == "tack" ? truth.tack() : truth.head();
+      const double sigma = sail.at("uncertainty").at(corner + "_m").get<double>();
       EXPECT_LT((at - want).norm(), 3.0 * sigma) << corner << " at " << at.transpose() << " ± " << sigma;
       // And σ says what the samples know: at the head the footprint's shift past the
       // samples' tip (9 cm, known to a quarter) and the tip's gap, about 2.6 cm in all
