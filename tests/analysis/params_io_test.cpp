@@ -65,6 +65,9 @@ AnalysisParams changedParams() {
   p.sections.fractions = {0.2, 0.4, 0.6, 0.8};
   p.sections.plane = "horizontal";
   p.sections.curve_points = 101;
+  p.mixed_pixels = false;
+  p.mixed.jump_sigmas = 6.5;
+  p.mixed.max_missing = 3;
   return p;
 }
 
@@ -94,6 +97,9 @@ TEST(ParamsJson, RoundTripsEveryChangedField) {
   EXPECT_EQ(out.outline.design_lengths_m, (std::vector<double>{10.0, 10.5, 3.6}));
   EXPECT_EQ(out.sections.fractions, (std::vector<double>{0.2, 0.4, 0.6, 0.8}));
   EXPECT_EQ(out.sections.curve_points, 101);
+  EXPECT_FALSE(out.mixed_pixels);
+  EXPECT_EQ(out.mixed.jump_sigmas, 6.5);
+  EXPECT_EQ(out.mixed.max_missing, 3);
 }
 
 TEST(ParamsJson, APartialDocumentOverridesOnlyWhatItSets) {
