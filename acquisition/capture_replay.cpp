@@ -55,6 +55,7 @@ ReplayCloud replayToCloud(const ReplayResult& replay, const UnitConfig& unit) {
   validateUnit(unit);
   ReplayCloud out;
   size_t without_encoder = 0, without_dist = 0;
+  std::vector<std::pair<uint16_t, double>> line_beta_deg;  // per frame used: counter, β at the middle beam
   const auto& frames = replay.frames;
   for (size_t k = 0; k < frames.size(); ++k) {
     const ScanData& s = frames[k].scan;
@@ -80,6 +81,8 @@ ReplayCloud replayToCloud(const ReplayResult& replay, const UnitConfig& unit) {
     ++out.scans_used;
     out.beams += dist->values.size();
     const double alpha0_deg = scanAngleDeg(*dist, 0);
+    const double mid_deg = 0.5 * (scanAngleDeg(*dist, dist->values.size() - 1) - alpha0_deg);
+    line_beta_deg.emplace_back(s.scan_counter, beta0 + mid_deg / 360.0 * rate_deg_per_turn);
     for (size_t i = 0; i < dist->values.size(); ++i) {
       if (dist->values[i] == 0) continue;
       const double range_m = scanRangeMm(*dist, i) / 1000.0;
@@ -100,6 +103,7 @@ ReplayCloud replayToCloud(const ReplayResult& replay, const UnitConfig& unit) {
     out.warnings.push_back(std::to_string(without_encoder) + " frames without an encoder block skipped (β unknown)");
   if (without_dist > 0) out.warnings.push_back(std::to_string(without_dist) + " frames without DIST1 skipped");
   out.cloud.viewpoint = unit.pose.translation();
+  out.cloud.lost_beta_rad = lostLineBetas(line_beta_deg);
   return out;
 }
 

@@ -60,6 +60,19 @@ std::vector<Vec3> previewPoints(const UnitConfig& unit, const ScanData& s, doubl
 
 }  // namespace
 
+std::vector<double> lostLineBetas(const std::vector<std::pair<uint16_t, double>>& counter_beta_deg) {
+  std::vector<double> out;
+  for (size_t k = 1; k < counter_beta_deg.size(); ++k) {
+    const auto [c0, b0] = counter_beta_deg[k - 1];
+    const auto [c1, b1] = counter_beta_deg[k];
+    const uint16_t step = static_cast<uint16_t>(c1 - c0);  // the counter wraps at 65,536
+    if (b1 == b0) continue;  // the turntable stood: the lost scans repeat a line received
+    for (uint16_t j = 1; j < step; ++j) out.push_back((b0 + (b1 - b0) * j / step) * kDeg);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 Vec3 sweepPointPosition(const UnitConfig& unit, double r, double alpha, double beta) {
   return unit.pose * unitPoint(r, alpha, beta, unit.p_m, unit.theta_rad);
 }
@@ -216,6 +229,8 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
   const double clock_offset = running_offset;  // over every scan received
   const bool encoder = unit.beta_source == BetaSource::Encoder;
   size_t used = 0;
+  // Each used scan's counter and β at its middle beam: where the lost lines lay.
+  std::vector<std::pair<uint16_t, double>> line_beta_deg;
   // Scans the device counted but never delivered: gaps in the scan counter between received scans.
   for (size_t k = 1; k < scans.size(); ++k) {
     const uint16_t step = static_cast<uint16_t>(scans[k].data.scan_counter - scans[k - 1].data.scan_counter);
@@ -264,6 +279,9 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     ++used;
     sweep.beams += dist->values.size();
     const double first_alpha_deg = scanAngleDeg(*dist, 0);
+    const double mid = 0.5 * (scanAngleDeg(*dist, dist->values.size() - 1) - first_alpha_deg) / 360.0;
+    line_beta_deg.emplace_back(s.scan_counter, encoder ? beta0 + mid * (beta_rate + mid * beta_curve)
+                                                       : interpolateBeta(table_samples, scan_host_start + mid * period_s));
     for (size_t i = 0; i < dist->values.size(); ++i) {
       if (dist->values[i] == 0) continue;  // no echo
       SweepPoint p;
@@ -288,6 +306,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     sweep.beta_end_deg = sweep.points.back().beta_rad / kDeg;
   }
   sweep.cloud.viewpoint = unit.pose.translation();
+  sweep.cloud.lost_beta_rad = lostLineBetas(line_beta_deg);
   sweep.cloud.points.reserve(sweep.points.size());
   for (const SweepPoint& p : sweep.points) {
     sweep.cloud.points.push_back(sweepPointPosition(unit, p.range_m, p.alpha_rad, p.beta_rad));

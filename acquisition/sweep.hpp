@@ -69,6 +69,12 @@ void validateSweepOptions(const SweepOptions& options);
 // started end the sweep early with `partial` set instead.
 Sweep runSweep(const UnitConfig& unit, const SweepOptions& options = {}, const Progress& progress = {});
 
+// The β (rad) of the scans lost between those received, from each received scan's
+// counter and β at its middle beam (degrees), in the order received: the turntable
+// turns evenly across a short gap, so the lost lines lie evenly between the scans
+// around it. Ascending (Cloud::lost_beta_rad).
+std::vector<double> lostLineBetas(const std::vector<std::pair<uint16_t, double>>& counter_beta_deg);
+
 // The 3D point of one sample by SPEC §2 and the unit's pose.
 Vec3 sweepPointPosition(const UnitConfig& unit, double range_m, double alpha_rad, double beta_rad);
 

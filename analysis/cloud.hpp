@@ -17,6 +17,10 @@ struct Cloud {
   std::vector<double> alpha_rad;       // scanner mirror angle α of each sample (SPEC §2)
   std::vector<double> beta_rad;        // turntable angle β of each sample
   std::optional<Vec3> viewpoint;       // scanner origin, same frame as points
+  // Turntable angles β of the scan lines the sweep lost (the scanner counted them and
+  // none arrived), ascending, each at its line's middle beam. An edge beside one may lie
+  // a line spacing further out than the samples say.
+  std::vector<double> lost_beta_rad;
 
   size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }

@@ -86,12 +86,14 @@ class CloudBuilder {
     if (present_[kBeta]) cloud_.beta_rad.push_back(v[kBeta]);
   }
 
-  CloudReadResult finish(const std::string& path, std::string format, const std::optional<Vec3>& viewpoint) {
+  CloudReadResult finish(const std::string& path, std::string format, const std::optional<Vec3>& viewpoint,
+                         std::vector<double> lost_beta_rad = {}) {
     if (seen_ == 0) throw fileError(path, "no points");
     if (cloud_.empty())
       throw fileError(path, "no finite points (all " + std::to_string(seen_) + " points have NaN coordinates)");
     CloudReadResult result;
     cloud_.viewpoint = viewpoint;
+    cloud_.lost_beta_rad = std::move(lost_beta_rad);
     result.cloud = std::move(cloud_);
     result.format = std::move(format);
     result.dropped_nan_points = dropped_;
@@ -214,7 +216,7 @@ CloudReadResult readPly(const std::string& path, const std::string& buf) {
   if (header.encoding == PlyEncoding::Ascii) {
     CloudBuilder builder(present, reserveFor(vertex.count, bytes_left, 2 * vertex.properties.size()));
     readPlyAsciiVertices(path, buf, header, vertex_index, roles, builder);
-    return builder.finish(path, "ply-ascii", header.viewpoint);
+    return builder.finish(path, "ply-ascii", header.viewpoint, header.lost_beta_rad);
   }
 
   const bool file_little = header.encoding == PlyEncoding::BinaryLittleEndian;
@@ -223,7 +225,7 @@ CloudReadResult readPly(const std::string& path, const std::string& buf) {
   for (size_t e = 0; e < vertex_index; ++e) pos = skipBinaryElement(path, buf, pos, header.elements[e], swap);
   CloudBuilder builder(present, reserveFor(vertex.count, buf.size() - pos, vertex.fixedSize()));
   readPlyBinaryVertices(path, buf, pos, swap, vertex, roles, builder);
-  return builder.finish(path, "ply-binary", header.viewpoint);
+  return builder.finish(path, "ply-binary", header.viewpoint, header.lost_beta_rad);
 }
 
 // ---------------------------------------------------------------------------
@@ -659,6 +661,15 @@ std::string plyContent(const Cloud& cloud, const Columns& c, bool binary) {
   if (cloud.viewpoint) {
     out += "comment viewpoint";
     appendViewpointNumbers(out, *cloud.viewpoint);
+    out += '\n';
+  }
+  // Ten to a line: a long sweep may lose many.
+  for (size_t i = 0; i < cloud.lost_beta_rad.size(); i += 10) {
+    out += "comment lost_beta_rad";
+    for (size_t k = i; k < std::min(i + 10, cloud.lost_beta_rad.size()); ++k) {
+      out += ' ';
+      appendNumber(out, cloud.lost_beta_rad[k]);
+    }
     out += '\n';
   }
   out += "element vertex " + std::to_string(cloud.size()) + "\n";

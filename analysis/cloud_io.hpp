@@ -25,7 +25,8 @@ struct CloudReadResult {
 CloudReadResult readCloud(const std::string& path);
 
 // Writes x y z plus intensity / alpha_rad / beta_rad when present; the viewpoint
-// is kept (PCD VIEWPOINT, PLY comment). Auto picks binary PLY for .ply,
+// is kept (PCD VIEWPOINT, PLY comment), and in PLY a sweep's lost scan lines
+// (Cloud::lost_beta_rad, "comment lost_beta_rad ..."). Auto picks binary PLY for .ply,
 // binary PCD for .pcd, CSV for .csv and space-separated text for .xyz/.txt.
 void writeCloud(const std::string& path, const Cloud& cloud, CloudFormat format = CloudFormat::Auto);
 

@@ -38,14 +38,14 @@ struct ScanGrid {
   double d_alpha = 0, d_beta = 0;   // the angular steps, rad
 };
 
-ScanGrid scanGrid(const Cloud& c) {
-  ScanGrid g;
+// The samples of each scan line, lines by ascending β. Within a line β moves on by
+// the drift of one α step at most; between lines by about the whole line step. Most
+// gaps are of the first kind.
+std::vector<std::vector<uint32_t>> lineMembers(const Cloud& c) {
   const size_t n = c.size();
   std::vector<uint32_t> order(n);
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return c.beta_rad[a] < c.beta_rad[b]; });
-  // Within a line β moves on by the drift of one α step at most; between lines by
-  // about the whole line step. Most gaps are of the first kind.
   std::vector<double> gaps;
   gaps.reserve(n);
   for (size_t i = 1; i < n; ++i) gaps.push_back(c.beta_rad[order[i]] - c.beta_rad[order[i - 1]]);
@@ -55,6 +55,12 @@ ScanGrid scanGrid(const Cloud& c) {
     if (i > 0 && gaps[i - 1] > split) members.emplace_back();
     members.back().push_back(order[i]);
   }
+  return members;
+}
+
+ScanGrid scanGrid(const Cloud& c) {
+  ScanGrid g;
+  std::vector<std::vector<uint32_t>> members = lineMembers(c);
   std::vector<double> alpha_steps, mean_beta;
   for (std::vector<uint32_t>& m : members) {
     std::sort(m.begin(), m.end(), [&](uint32_t a, uint32_t b) { return c.alpha_rad[a] < c.alpha_rad[b]; });
@@ -221,6 +227,28 @@ Cleaning removeMixedPixels(const Cloud& cloud, const MixedPixelParams& params) {
   out.kept.clear();
   for (uint32_t i = 0; i < cloud.size(); ++i) (mixed[i] ? out.removed : out.kept).push_back(i);
   return out;
+}
+
+std::vector<ScanLine> scanLines(const Cloud& cloud) {
+  std::vector<ScanLine> out;
+  if (!cloud.hasScanAngles() || cloud.alpha_rad.size() != cloud.size() || cloud.beta_rad.size() != cloud.size())
+    return out;
+  for (size_t i = 0; i < cloud.size(); ++i)
+    if (!std::isfinite(cloud.alpha_rad[i]) || !std::isfinite(cloud.beta_rad[i])) return out;
+  if (cloud.empty()) return out;
+  for (std::vector<uint32_t>& m : lineMembers(cloud)) {
+    double b = 0;
+    for (uint32_t s : m) b += cloud.beta_rad[s];
+    out.push_back({b / static_cast<double>(m.size()), std::move(m)});
+  }
+  return out;
+}
+
+double scanLineStepRad(const Cloud& cloud) {
+  const std::vector<ScanLine> lines = scanLines(cloud);
+  std::vector<double> steps;
+  for (size_t i = 1; i < lines.size(); ++i) steps.push_back(lines[i].beta_rad - lines[i - 1].beta_rad);
+  return medianOf(steps);
 }
 
 }  // namespace sailshape

@@ -46,4 +46,16 @@ Cleaning removeMixedPixels(const Cloud& cloud, const MixedPixelParams& params = 
 // Throws InvalidInput naming the parameter.
 void checkMixedPixelParams(const MixedPixelParams& params);
 
+// A scan line as the mixed-pixel grid reads it off the angles: its samples and
+// their mean turntable angle β.
+struct ScanLine {
+  double beta_rad = 0;
+  std::vector<uint32_t> samples;
+};
+// The cloud's scan lines by ascending β; none without finite scan angles.
+std::vector<ScanLine> scanLines(const Cloud& cloud);
+// The turntable's step between the cloud's scan lines (rad), their median; 0 with
+// fewer than two lines.
+double scanLineStepRad(const Cloud& cloud);
+
 }  // namespace sailshape

@@ -175,6 +175,63 @@ bool looksForMixedPixels(const Cloud& scan, const AnalysisParams& p) {
 }
 }  // namespace
 
+std::vector<std::string> widenCornersBesideLostLines(SailOutline& outline, const Cloud& scan) {
+  std::vector<std::string> warnings;
+  if (scan.lost_beta_rad.empty() || !scan.viewpoint) return warnings;
+  const std::vector<ScanLine> lines = scanLines(scan);
+  if (lines.size() < 2) return warnings;
+  // The turntable's step: between the lines taken across the cloud, received or lost
+  // (a sweep that lost every other scan leaves its received lines two steps apart).
+  std::vector<double> taken;
+  for (const ScanLine& l : lines) taken.push_back(l.beta_rad);
+  for (double b : scan.lost_beta_rad)
+    if (b > lines.front().beta_rad && b < lines.back().beta_rad) taken.push_back(b);
+  std::sort(taken.begin(), taken.end());
+  std::vector<double> steps;
+  for (size_t i = 1; i < taken.size(); ++i) steps.push_back(taken[i] - taken[i - 1]);
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+  const double step = steps[steps.size() / 2];
+  if (!(step > 0)) return warnings;
+  std::vector<uint32_t> line_of(scan.size(), 0);
+  for (uint32_t l = 0; l < lines.size(); ++l)
+    for (uint32_t s : lines[l].samples) line_of[s] = l;
+  // Is a line lost within half a step of β? (A lost line is stored at its middle
+  // beam, a received one at its samples' mean: a fraction of a step apart.)
+  auto lostNear = [&](double beta) {
+    const auto it = std::lower_bound(scan.lost_beta_rad.begin(), scan.lost_beta_rad.end(), beta - 0.5 * step);
+    return it != scan.lost_beta_rad.end() && *it < beta + 0.5 * step;
+  };
+  auto widen = [&](const char* name, const Vec3& corner, double& sigma) {
+    size_t nearest = 0;
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < scan.size(); ++i) {
+      const double d = (scan.points[i] - corner).squaredNorm();
+      if (d < best) best = d, nearest = i;
+    }
+    // Lost lines in a row beside the corner's line, on either side, each a step on:
+    // the edge may lie that many spacings further out.
+    const double beta = lines[line_of[nearest]].beta_rad;
+    int run = 0;
+    for (const int side : {-1, 1}) {
+      int k = 0;
+      while (k < 1000 && lostNear(beta + side * (k + 1) * step)) ++k;
+      run = std::max(run, k);
+    }
+    if (run == 0) return;
+    const double spacing = (corner - *scan.viewpoint).norm() * step;
+    sigma = std::hypot(sigma, run * spacing);
+    warnings.push_back(std::string(name) + ": " + (run == 1 ? "a scan line" : std::to_string(run) + " scan lines") +
+                       " the sweep lost lie beside it; it may lie up to " + formatFixed(100 * run * spacing, 1) +
+                       " cm further out (a line spacing each), and its uncertainty says so");
+  };
+  SailOutline::Uncertainty& u = outline.uncertainty;
+  widen("tack", outline.tack, u.tack_m);
+  widen("clew", outline.clew, u.clew_m);
+  widen("head", outline.head, u.head_m);
+  if (outline.has_peak) widen("peak", outline.peak, u.peak_m);
+  return warnings;
+}
+
 Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p) {
   if (!looksForMixedPixels(scan, p)) return scan;
   return selectPoints(scan, removeMixedPixels(scan, mixedPixelParams(p)).kept);
@@ -356,6 +413,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
       sample_density = static_cast<double>(a.sail_points) / std::max(1e-12, meshArea(a.mesh));
     }
     a.outline = extractOutline(a.mesh, p.outline, loose, sample_density, input.viewpoint);
+    for (std::string& w : widenCornersBesideLostLines(a.outline, input)) a.outline.warnings.push_back(std::move(w));
     a.luff = measureLuffCurve(a.outline);
     t.finish(a.outline.boundary.size(), a.outline.warnings);
   }

@@ -103,6 +103,14 @@ MixedPixelParams mixedPixelParams(const AnalysisParams& p);
 // told by the surfaces on both sides of them, which the crop would cut off.
 Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p);
 
+// A corner whose samples' scan line has lost lines beside it (Cloud::lost_beta_rad:
+// the sweep never received them) may lie a line spacing further out than the samples
+// place it for each lost in a row; that, |corner − viewpoint| times the turntable's
+// step between lines, joins the corner's σ. Needs the scan's angles and viewpoint;
+// `scan` is the cloud the outline was found on, in its frame. Lost lines must be
+// ascending, as sweeps write them. Returns a warning per corner widened.
+std::vector<std::string> widenCornersBesideLostLines(SailOutline& outline, const Cloud& scan);
+
 // Throws InvalidInput for an empty cloud or bad parameters, AnalysisError when
 // a stage cannot produce its result (no sail found, no boundary, ...).
 SailAnalysis analyzeSail(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {});

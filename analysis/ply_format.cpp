@@ -42,6 +42,17 @@ std::optional<Vec3> viewpointComment(const std::vector<std::string_view>& tokens
   return v;
 }
 
+std::optional<std::vector<double>> lostBetaComment(const std::vector<std::string_view>& tokens, size_t first) {
+  if (tokens.size() < first + 2 || tokens[first] != "lost_beta_rad") return std::nullopt;
+  std::vector<double> out;
+  for (size_t k = first + 1; k < tokens.size(); ++k) {
+    double x = 0;
+    if (parseNumber(tokens[k], x) != Parsed::Ok || !std::isfinite(x)) return std::nullopt;
+    out.push_back(x);
+  }
+  return out;
+}
+
 PlyHeader parsePlyHeader(const std::string& path, const std::string& buf) {
   LineReader lines(buf.data(), buf.data() + buf.size());
   std::string_view line;
@@ -69,6 +80,7 @@ PlyHeader parsePlyHeader(const std::string& path, const std::string& buf) {
       have_format = true;
     } else if (key == "comment") {
       if (auto v = viewpointComment(tok, 1)) header.viewpoint = v;
+      if (auto b = lostBetaComment(tok, 1)) header.lost_beta_rad.insert(header.lost_beta_rad.end(), b->begin(), b->end());
     } else if (key == "obj_info") {
       continue;
     } else if (key == "element") {

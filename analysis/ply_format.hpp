@@ -125,6 +125,7 @@ struct PlyHeader {
   PlyEncoding encoding = PlyEncoding::Ascii;
   std::vector<PlyElement> elements;
   std::optional<Vec3> viewpoint;  // from a "comment viewpoint X Y Z" line
+  std::vector<double> lost_beta_rad;  // from "comment lost_beta_rad B1 B2 ..." lines
   size_t data_offset = 0;         // first byte after "end_header\n"
   size_t end_header_line = 0;     // line number of end_header
 };
@@ -134,6 +135,9 @@ bool isIntegerScalar(Scalar t);
 // "viewpoint X Y Z" from `first` on (after a comment marker): the scanner origin, when the three
 // values are finite numbers.
 std::optional<Vec3> viewpointComment(const std::vector<std::string_view>& tokens, size_t first);
+// "lost_beta_rad B1 B2 ..." from `first` on: the β of scan lines a sweep lost
+// (Cloud::lost_beta_rad), when every value is a finite number.
+std::optional<std::vector<double>> lostBetaComment(const std::vector<std::string_view>& tokens, size_t first);
 
 // Throws FileError naming the line of the first malformed header line.
 PlyHeader parsePlyHeader(const std::string& path, const std::string& buf);

@@ -35,37 +35,69 @@ SparFit fitSpar(const Cloud& cloud, const Spar& nominal, const SparFitParams& p)
   // Sideways coordinates (relative to the nominal axis) of the points near it.
   const double reach = s.radius_m + p.search_m + 3 * p.sensor_sigma_m;
   std::vector<Eigen::Vector2d> q;
+  std::vector<int> part;  // which tenth of the spar's length each lies along
   for (const Vec3& x : cloud.points) {
     const Vec3 d = x - s.base;
     const double along = d.dot(s.axis);
     if (along < 0 || along > s.length_m) continue;
     const Eigen::Vector2d w(d.dot(u), d.dot(v));
-    if (w.norm() <= reach) q.push_back(w);
+    if (w.norm() > reach) continue;
+    q.push_back(w);
+    part.push_back(std::min(9, static_cast<int>(10.0 * along / s.length_m)));
   }
   SparFit fit;
   fit.spar = s;
   const double band = 2 * p.sensor_sigma_m;
-  auto support = [&](const Eigen::Vector2d& c) {
-    size_t n = 0;
-    for (const auto& w : q) n += std::abs((w - c).norm() - s.radius_m) <= band;
-    return n;
+  // Points on the round surface for it; points inside it against it, as a solid spar
+  // returns nothing from within: a cylinder straddling a sail, which crosses its
+  // surface twice, has the sail's strip between the crossings inside. (A 25 mm mast
+  // 3 m off shows on two or three scan lines, a sail crossing it on two: with a line
+  // lost, the straddling place won and the mast was put on the luff, 6 cm aft.)
+  // And a spar runs its whole length: a place whose surface points stand on less than
+  // half of it is something else's (a sail's luff strip, the mast's foot and head when
+  // the scan lost the lines on its body), and the spar is not found there.
+  constexpr long kShort = std::numeric_limits<long>::min() + 1;  // surface points on less than half the length
+  auto support = [&](const Eigen::Vector2d& c, size_t* on = nullptr) {
+    long n = 0;
+    size_t surface = 0;
+    std::array<bool, 10> seen{};
+    for (size_t k = 0; k < q.size(); ++k) {
+      const double r = (q[k] - c).norm() - s.radius_m;
+      if (std::abs(r) <= band) {
+        ++surface;
+        seen[static_cast<size_t>(part[k])] = true;
+      } else if (r < -band) {
+        --n;
+      }
+    }
+    if (on) *on = surface;
+    if (std::count(seen.begin(), seen.end(), true) < 5) return kShort;
+    return n + static_cast<long>(surface);
   };
   // Vote: every 2 mm offset within the search disc; the one most points fit wins.
   const double step = 0.002;
   const int steps = static_cast<int>(std::ceil(p.search_m / step));
   Eigen::Vector2d best = Eigen::Vector2d::Zero();
+  long best_score = std::numeric_limits<long>::min();
   size_t best_n = 0;
   for (int i = -steps; i <= steps; ++i)
     for (int j = -steps; j <= steps; ++j) {
       const Eigen::Vector2d c(i * step, j * step);
       if (c.norm() > p.search_m) continue;
-      const size_t n = support(c);
+      size_t n = 0;
+      const long score = support(c, &n);
       // Ties go to the offset nearest the nominal place.
-      if (n > best_n || (n == best_n && c.norm() < best.norm())) {
+      if (score > best_score || (score == best_score && c.norm() < best.norm())) {
+        best_score = score;
         best_n = n;
         best = c;
       }
     }
+  if (best_score == kShort) {
+    fit.message = "spar '" + s.name + "': no place within " + formatFixed(p.search_m) +
+                  " m of its nominal place has points on its surface along half its length";
+    return fit;
+  }
   if (best_n < p.min_support) {
     fit.message = "spar '" + s.name + "': " + std::to_string(best_n) + " points on its surface within " +
                   std::to_string(p.search_m) + " m of its nominal place (needs " + std::to_string(p.min_support) + ")";

@@ -34,8 +34,9 @@ struct SparFit {
 };
 
 // Looks for the spar's round surface (radius and direction as given) within
-// search_m of its nominal axis: the axis position that the most points fit
-// (a vote over a 2 mm grid of sideways offsets), refined by least squares.
+// search_m of its nominal axis: the axis position that the most points fit, less
+// the points inside it (a vote over a 2 mm grid of sideways offsets), refined by
+// least squares.
 // When too few points support any position the nominal spar is returned with
 // found = false. Throws InvalidInput for a zero axis, length or radius.
 SparFit fitSpar(const Cloud& cloud, const Spar& nominal, const SparFitParams& params = {});

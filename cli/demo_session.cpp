@@ -329,6 +329,16 @@ DemoResult runDemo(const DemoOptions& o, const DemoLog& log_fn, const Progress& 
     std::ofstream(path) << unitToJson(u.config) << "\n";
     result.unit_files.push_back(path);
   }
+  {  // What the emulator really did, to check the demo's results against: where each
+     // unit stood (4×4 row-major, scanner to boat frame, as the database's registrations).
+    json units = json::array();
+    for (const RigUnit& u : rig) {
+      json rows = json::array();
+      for (int r = 0; r < 4; ++r) rows.push_back({u.true_pose(r, 0), u.true_pose(r, 1), u.true_pose(r, 2), u.true_pose(r, 3)});
+      units.push_back({{"name", u.config.name}, {"sail", u.sail}, {"true_pose", rows}});
+    }
+    std::ofstream(fs::path(o.dir) / "emulator-truth.json") << json{{"units", units}}.dump(2) << "\n";
+  }
 
   {  // the database stays open while the steps are stored; the report reads the closed file
     Database db = openSailDatabase(result.database);

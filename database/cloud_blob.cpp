@@ -15,7 +15,8 @@ constexpr char kMagic[4] = {'S', 'S', 'C', '1'};
 constexpr uint32_t kHasIntensity = 1;
 constexpr uint32_t kHasScanAngles = 2;  // float32 α then β per point (rad)
 constexpr uint32_t kHasViewpoint = 4;   // three float64 after the per-point data
-constexpr uint32_t kKnownFlags = kHasIntensity | kHasScanAngles | kHasViewpoint;
+constexpr uint32_t kHasLostLines = 8;   // after those, a uint32 count and as many float64 β (rad)
+constexpr uint32_t kKnownFlags = kHasIntensity | kHasScanAngles | kHasViewpoint | kHasLostLines;
 constexpr size_t kHeader = 4 + 8 + 4;  // magic, point count, flags
 
 template <typename T>
@@ -36,8 +37,9 @@ std::vector<uint8_t> compressCloud(const Cloud& cloud) {
   const size_t n = cloud.size();
   const bool intensity = cloud.hasIntensity() && cloud.intensity.size() == n;
   const bool angles = cloud.hasScanAngles() && cloud.alpha_rad.size() == n && cloud.beta_rad.size() == n;
+  const bool lost = !cloud.lost_beta_rad.empty();
   const uint32_t flags = (intensity ? kHasIntensity : 0) | (angles ? kHasScanAngles : 0) |
-                         (cloud.viewpoint ? kHasViewpoint : 0);
+                         (cloud.viewpoint ? kHasViewpoint : 0) | (lost ? kHasLostLines : 0);
   std::vector<uint8_t> raw;
   raw.reserve(kHeader + n * (12 + (intensity ? 4 : 0) + (angles ? 8 : 0)) + (cloud.viewpoint ? 24 : 0));
   raw.insert(raw.end(), kMagic, kMagic + 4);
@@ -56,6 +58,11 @@ std::vector<uint8_t> compressCloud(const Cloud& cloud) {
   // The scanner's position orients the normals and places the beam's footprint at the edges.
   if (cloud.viewpoint)
     for (int k = 0; k < 3; ++k) put<double>(raw, (*cloud.viewpoint)[k]);
+  // The scan lines its sweep lost: a corner beside one may lie a line further out.
+  if (lost) {
+    put<uint32_t>(raw, static_cast<uint32_t>(cloud.lost_beta_rad.size()));
+    for (double b : cloud.lost_beta_rad) put<double>(raw, b);
+  }
   // The uncompressed size first, so decompression knows its buffer.
   std::vector<uint8_t> out;
   put<uint64_t>(out, raw.size());
@@ -85,8 +92,10 @@ Cloud decompressCloud(const std::vector<uint8_t>& blob) {
   if (flags & ~kKnownFlags)
     throw DatabaseError("[decompressCloud] cloud flags 0x" + hex(flags) + " are unknown: written by a newer sailshape");
   const uint64_t per_point = 12 + ((flags & kHasIntensity) ? 4 : 0) + ((flags & kHasScanAngles) ? 8 : 0);
-  if (n > raw_size / per_point ||
-      raw_size != kHeader + n * per_point + ((flags & kHasViewpoint) ? 24 : 0))
+  const uint64_t fixed = n > raw_size / per_point ? raw_size + 1 : kHeader + n * per_point + ((flags & kHasViewpoint) ? 24 : 0);
+  uint32_t lost = 0;
+  if ((flags & kHasLostLines) && fixed + 4 <= raw_size) std::memcpy(&lost, raw.data() + fixed, 4);
+  if (fixed > raw_size || raw_size != fixed + ((flags & kHasLostLines) ? 4 + 8 * uint64_t(lost) : 0))
     throw DatabaseError("[decompressCloud] " + std::to_string(n) + " points do not fit " + std::to_string(raw_size) + " bytes");
   Cloud cloud;
   cloud.points.resize(n);
@@ -113,6 +122,11 @@ Cloud decompressCloud(const std::vector<uint8_t>& blob) {
     double v[3];
     std::memcpy(v, p, 24);
     cloud.viewpoint = Vec3(v[0], v[1], v[2]);
+    p += 24;
+  }
+  if (flags & kHasLostLines) {
+    cloud.lost_beta_rad.resize(lost);
+    std::memcpy(cloud.lost_beta_rad.data(), p + 4, 8 * uint64_t(lost));
   }
   return cloud;
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -12,6 +13,7 @@
 #include "acquisition/sweep.hpp"
 #include "acquisition/turntable.hpp"
 #include "analysis/errors.hpp"
+#include "analysis/mixed_pixels.hpp"
 
 using namespace sailshape;
 
@@ -159,6 +161,26 @@ TEST(Sweep, AHostTooSlowForTheScanRateLosesScansNotTheEndOfTheSweep) {
       for (const std::string& w : s.warnings) said = said || w.find("never arrived") != std::string::npos;
       EXPECT_EQ(s.scans_missed > 0, max_lag_s < 1.0);
       EXPECT_EQ(said, s.scans_missed > 0) << "the lost scans are said";
+      // And where: a β per scan lost while the turntable turned (one lost while it stood
+      // at the end lost no line), in the gap it left between the lines received. At full
+      // speed (2° from either end: 40°/s reached at 400°/s²) a line's samples span a
+      // fraction of a step, and none lies within half a step of a lost line.
+      EXPECT_LE(s.cloud.lost_beta_rad.size(), s.scans_missed);
+      EXPECT_EQ(s.cloud.lost_beta_rad.empty(), s.scans_missed == 0);
+      EXPECT_TRUE(std::is_sorted(s.cloud.lost_beta_rad.begin(), s.cloud.lost_beta_rad.end()));
+      const double step = scanLineStepRad(s.cloud);
+      ASSERT_GT(step, 0);
+      size_t at_speed = 0;
+      for (const double b : s.cloud.lost_beta_rad) {
+        EXPECT_GT(b, s.beta_start_deg * kDeg);
+        EXPECT_LT(b, s.beta_end_deg * kDeg);
+        if (b < (s.beta_start_deg + 2) * kDeg || b > (s.beta_end_deg - 2) * kDeg) continue;
+        ++at_speed;
+        double nearest = 1e9;
+        for (const double pb : s.cloud.beta_rad) nearest = std::min(nearest, std::abs(pb - b));
+        EXPECT_GT(nearest, 0.5 * step) << "lost line at " << b;
+      }
+      EXPECT_EQ(at_speed > 0, s.scans_missed > 0) << "the host loses scans all along";
     }
 }
 

@@ -250,6 +250,26 @@ TEST_F(CloudIoTest, PlyBigEndianWithMixedTypes) {
   EXPECT_EQ(*r.cloud.viewpoint, Vec3(1.5, -2, 3));
 }
 
+// A sweep's lost scan lines (Cloud::lost_beta_rad) travel with its PLY: ten to a
+// comment line, exactly; a comment that is not a list of numbers is only a comment.
+TEST_F(CloudIoTest, PlyKeepsTheSweepsLostScanLines) {
+  Cloud cloud = makeCloud(20, true);
+  for (int k = 0; k < 23; ++k) cloud.lost_beta_rad.push_back(-0.25 + 0.0058177641733144 * k + 1e-13 * k);
+  for (const CloudFormat f : {CloudFormat::PlyAscii, CloudFormat::PlyBinary}) {
+    const std::string p = path(f == CloudFormat::PlyAscii ? "a.ply" : "b.ply");
+    writeCloud(p, cloud, f);
+    const CloudReadResult r = readCloud(p);
+    expectSameCloud(cloud, r.cloud);
+    EXPECT_EQ(r.cloud.lost_beta_rad, cloud.lost_beta_rad);
+    // And a crop keeps them: they say where the sweep has no line, whatever is cut.
+    EXPECT_EQ(selectPoints(r.cloud, {3, 4}).lost_beta_rad, cloud.lost_beta_rad);
+  }
+  const CloudReadResult r = readCloud(
+      write("odd.ply", "ply\nformat ascii 1.0\ncomment lost_beta_rad 0.1 lots\ncomment lost_beta_rad 0.2\n"
+                       "element vertex 1\nproperty double x\nproperty double y\nproperty double z\nend_header\n1 2 3\n"));
+  EXPECT_EQ(r.cloud.lost_beta_rad, (std::vector<double>{0.2}));
+}
+
 TEST_F(CloudIoTest, PlyAllScalarTypeNames) {
   Bytes b;
   b.text(

@@ -239,3 +239,54 @@ TEST(MixedPixels, BadInputIsOneClearError) {
     EXPECT_STREQ(e.what(), "[removeMixedPixels] max_run_rad must be > 0 (got 0.000000)");
   }
 }
+
+// A corner beside a scan line the sweep lost: the samples place it on the last line
+// received, and the edge may lie a line spacing further out for each line lost in a
+// row beside it; that joins its σ. Lines lost elsewhere change nothing.
+TEST(LostScanLines, WidenTheCornersBesideThem) {
+  const Vec3 mid = direction(kAlpha0 + 120 * kAlphaStep, kBeta0 + 60 * kBetaStep);
+  const Vec3 front = kScanner + 3.5 * mid;
+  Cloud c = scan(
+      [&](int l, int k) -> std::optional<Sample> {
+        if (l < 30 || l >= 90 || k < 60 || k >= 180) return std::nullopt;
+        return Sample{rangeToPlane(l, k, front, -mid), false};
+      },
+      3);
+  EXPECT_NEAR(scanLineStepRad(c), kBetaStep, 1e-9);
+  // The panel's corners, where its samples end.
+  auto at = [&](int l, int k) {
+    const double alpha = kAlpha0 + k * kAlphaStep, beta = kBeta0 + l * kBetaStep + 0.4 * kBetaStep * k / kSteps;
+    return Vec3(kScanner + rangeToPlane(l, k, front, -mid) * direction(alpha, beta));
+  };
+  SailOutline o;
+  o.tack = at(30, 60);
+  o.head = at(30, 179);
+  o.clew = at(89, 60);
+  o.uncertainty.tack_m = o.uncertainty.head_m = o.uncertainty.clew_m = 0.005;
+  // A lost line is stored at its middle beam.
+  auto lostLine = [&](int l) { return kBeta0 + l * kBetaStep + 0.2 * kBetaStep; };
+  auto spacingAt = [&](const Vec3& p) { return (p - kScanner).norm() * kBetaStep; };
+  {
+    SailOutline w = o;
+    c.lost_beta_rad = {lostLine(50), lostLine(92)};  // inside the panel; two lines past its far edge
+    EXPECT_TRUE(widenCornersBesideLostLines(w, c).empty());
+    EXPECT_EQ(w.uncertainty.tack_m, 0.005);
+    EXPECT_EQ(w.uncertainty.clew_m, 0.005);
+  }
+  for (const int lost : {1, 2}) {
+    SailOutline w = o;
+    c.lost_beta_rad.clear();
+    for (int l = 30 - lost; l < 30; ++l) c.lost_beta_rad.push_back(lostLine(l));
+    const std::vector<std::string> warnings = widenCornersBesideLostLines(w, c);
+    ASSERT_EQ(warnings.size(), 2u) << "tack and head";
+    EXPECT_EQ(warnings[0].rfind("tack: ", 0), 0u) << warnings[0];
+    EXPECT_NEAR(w.uncertainty.tack_m, std::hypot(0.005, lost * spacingAt(o.tack)), 1e-12);
+    EXPECT_NEAR(w.uncertainty.head_m, std::hypot(0.005, lost * spacingAt(o.head)), 1e-12);
+    EXPECT_EQ(w.uncertainty.clew_m, 0.005);
+  }
+  // Without a viewpoint nothing says how far apart the lines lie.
+  c.viewpoint.reset();
+  SailOutline w = o;
+  EXPECT_TRUE(widenCornersBesideLostLines(w, c).empty());
+  EXPECT_EQ(w.uncertainty.tack_m, 0.005);
+}

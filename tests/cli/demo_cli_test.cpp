@@ -132,32 +132,56 @@ TEST_F(DemoRun, AnalysedSailsHaveSectionsAndADesignComparison) {
   EXPECT_GE(sections["Demo 36 A2"], 3) << "the gennaker is analysed at one step at least:\n" << outcome_.out;
 }
 
-// The main's head where it flies (its tack, beside mast and boom, came out 3.8 cm off
-// at ±0.9 cm in one sanitizer run: open, see the issue note): the example main at the model's 1:3.6 (its
-// flying trim twists the sections about the luff, so its tack and head are the
-// design's), each within 3 of its reported σ. Mixed pixels against the A2 behind
-// it, and corner curves meeting parallel at its 20° head, once put the head 23-30 cm
-// high, and now and then past the 10 % luff check.
-TEST_F(DemoRun, TheMainsHeadStandsWhereTheSailFlies) {
+// The main's tack and head where the sail flies, each within 3 of its reported σ:
+// the example main at the model's 1:3.6 (its flying trim twists the sections about
+// the luff, so its tack and head are the design's), seen in the frame the unit's
+// registration on the tunnel walls put it in (emulator-truth.json: where the unit
+// really stood; the registration leaves it about 2 cm off, and the corners with it).
+// Mixed pixels against the A2 behind it, and corner curves meeting parallel at its
+// 20° head, once put the head 23-30 cm high. Under load the emulator loses scans
+// (its host cannot ray-cast 25 a second); a lost line beside the luff put the tack
+// 3.4 cm aft at ±0.6 cm, until the σ took the lost line in.
+TEST_F(DemoRun, TheMainsCornersStandWhereTheSailFlies) {
   ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
   const sailshape::SailSurface truth(sailshape::scaleDesign(sailshape::exampleDesign(sailshape::SailType::Main), 1.0 / 3.6));
+  auto pose = [](const nlohmann::json& rows) {
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) t.matrix()(r, c) = rows.at(r).at(c).get<double>();
+    return t;
+  };
+  Eigen::Isometry3d true_pose = Eigen::Isometry3d::Identity();
+  {
+    std::ifstream in(dir_ / "out" / "emulator-truth.json");
+    ASSERT_TRUE(in.good()) << "the demo writes what the emulator really did";
+    bool found = false;
+    const nlohmann::json doc = nlohmann::json::parse(in);
+    for (const auto& u : doc.at("units"))
+      if (u.at("sail") == "Demo 36 main") true_pose = pose(u.at("true_pose")), found = true;
+    ASSERT_TRUE(found);
+  }
   sailshape::Database db = sailshape::openSailDatabase((dir_ / "out" / "sailshape.db").string());
   auto st = db.prepare(
-      "SELECT a.sail FROM analyses a JOIN scans s ON s.id = a.scan_id JOIN trim_steps t ON t.id = s.trim_step_id "
+      "SELECT a.sail, r.transform FROM analyses a JOIN scans s ON s.id = a.scan_id "
+      "JOIN registrations r ON r.scan_id = s.id JOIN trim_steps t ON t.id = s.trim_step_id "
       "JOIN sails sa ON sa.id = t.sail_id WHERE sa.name = 'Demo 36 main'");
   int analyses = 0;
   while (st.step()) {
     ++analyses;
     const nlohmann::json sail = nlohmann::json::parse(st.columnText(0));
-    for (const auto& [corner, want] : {std::pair<std::string, sailshape::Vec3>{"head", truth.head()}}) {
+    // Boat frame as registered ← the unit ← the boat frame as it is.
+    const Eigen::Isometry3d seen = pose(nlohmann::json::parse(st.columnText(1))) * true_pose.inverse();
+    for (const auto& [corner, want] : {std::pair<std::string, sailshape::Vec3>{"tack", seen * truth.tack()},
+                                       {"head", seen * truth.head()}}) {
       const auto& c = sail.at(corner);
       const sailshape::Vec3 at(c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<double>());
       const double sigma = sail.at("uncertainty").at(corner + "_m").get<double>();
-      EXPECT_LT((at - want).norm(), 3.0 * sigma) << corner << " at " << at.transpose() << " ± " << sigma;
+      EXPECT_LT((at - want).norm(), 3.0 * sigma) << corner << " at " << at.transpose() << " ± " << sigma << ", flies at "
+                                                 << want.transpose();
       // And σ says what the samples know: at the head the footprint's shift past the
       // samples' tip (9 cm, known to a quarter) and the tip's gap, about 2.6 cm in all
       // (tests/acquisition: TunnelMainScan); twice that at most. (The heads placed 30 cm
-      // high came with ±17 cm.)
+      // high came with ±17 cm.) At the tack a line spacing or two (1.7 cm each) at most.
       EXPECT_LT(sigma, 0.052) << corner;
     }
   }

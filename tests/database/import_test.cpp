@@ -139,10 +139,10 @@ TEST(CloudBlob, ReadsBlobsWrittenBeforeTheAnglesWereKept) {
 
 TEST(CloudBlob, RefusesFlagsItDoesNotKnow) {
   try {
-    decompressCloud(handMadeBlob(1, 1 | 8, {1, 2, 3, 70, 0}));
-    FAIL() << "a blob with flag 8 was read";
+    decompressCloud(handMadeBlob(1, 1 | 16, {1, 2, 3, 70, 0}));
+    FAIL() << "a blob with flag 16 was read";
   } catch (const DatabaseError& e) {
-    EXPECT_STREQ(e.what(), "[decompressCloud] cloud flags 0x9 are unknown: written by a newer sailshape");
+    EXPECT_STREQ(e.what(), "[decompressCloud] cloud flags 0x11 are unknown: written by a newer sailshape");
   }
   // Angles announced but missing: the sizes do not add up.
   try {
@@ -151,6 +151,27 @@ TEST(CloudBlob, RefusesFlagsItDoesNotKnow) {
   } catch (const DatabaseError& e) {
     EXPECT_STREQ(e.what(), "[decompressCloud] 2 points do not fit 40 bytes");
   }
+  // Lost lines announced: a count of none, and a count far beyond the bytes.
+  EXPECT_TRUE(decompressCloud(handMadeBlob(1, 8, {1, 2, 3, 0})).lost_beta_rad.empty());  // a count of 0
+  try {
+    decompressCloud(handMadeBlob(1, 8, {1, 2, 3, 1.0f}));  // 1.0f read as a count of 1,065,353,216 lines
+    FAIL() << "a blob short of its lost lines was read";
+  } catch (const DatabaseError& e) {
+    EXPECT_STREQ(e.what(), "[decompressCloud] 1 points do not fit 32 bytes");
+  }
+}
+
+// A stored scan keeps the lines its sweep lost: a re-analysis widens the corners beside them.
+TEST(CloudBlob, KeepsTheLinesTheSweepLost) {
+  Cloud c = noisyCloud(100, 5);
+  c.viewpoint = Vec3(1, 2, 3);
+  c.lost_beta_rad = {-0.25, -0.1234567890123, 0.5};
+  const Cloud d = decompressCloud(compressCloud(c));
+  EXPECT_EQ(d.lost_beta_rad, c.lost_beta_rad);
+  ASSERT_TRUE(d.viewpoint.has_value());
+  EXPECT_EQ(*d.viewpoint, *c.viewpoint);
+  c.lost_beta_rad.clear();
+  EXPECT_TRUE(decompressCloud(compressCloud(c)).lost_beta_rad.empty());
 }
 
 TEST(Import, StoresAnalysisTrimStepAndCloudInOneTransaction) {
