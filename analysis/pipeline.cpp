@@ -302,6 +302,11 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), w);
   }
 
+  // The sail's own samples, with their scan angles, when the sweep lost lines: a
+  // corner's line is the line of the sail sample nearest it (not the boom's below a tack).
+  Cloud sail_scan;
+  if (!input.lost_beta_rad.empty()) sail_scan = cloud;
+
   // How many scan points each working point stands for (empty: one each), and the
   // scan's own sail points when the working points are column means.
   std::vector<uint32_t> represents;
@@ -413,7 +418,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
       sample_density = static_cast<double>(a.sail_points) / std::max(1e-12, meshArea(a.mesh));
     }
     a.outline = extractOutline(a.mesh, p.outline, loose, sample_density, input.viewpoint);
-    for (std::string& w : widenCornersBesideLostLines(a.outline, input)) a.outline.warnings.push_back(std::move(w));
+    for (std::string& w : widenCornersBesideLostLines(a.outline, sail_scan)) a.outline.warnings.push_back(std::move(w));
     a.luff = measureLuffCurve(a.outline);
     t.finish(a.outline.boundary.size(), a.outline.warnings);
   }

@@ -453,7 +453,7 @@ DemoResult runDemo(const DemoOptions& o, const DemoLog& log_fn, const Progress& 
             log(tag + ": " + u.config.name + ": " + nominal.name + " found " +
                 std::to_string(static_cast<int>(std::lround(1000 * f.offset.norm()))) + " mm from its measured place");
           else
-            log(tag + ": " + u.config.name + ": " + nominal.name + " not in view; its measured place is used");
+            log(tag + ": " + u.config.name + ": " + f.message + "; its measured place is used");
           spars.push_back(f.spar);
         }
         const double max_x = u.roi_ends_at_mast ? spars.front().base.x() : 1e9;
