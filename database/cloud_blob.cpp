@@ -124,7 +124,7 @@ Cloud decompressCloud(const std::vector<uint8_t>& blob) {
     cloud.viewpoint = Vec3(v[0], v[1], v[2]);
     p += 24;
   }
-  if (flags & kHasLostLines) {
+  if ((flags & kHasLostLines) && lost > 0) {
     cloud.lost_beta_rad.resize(lost);
     std::memcpy(cloud.lost_beta_rad.data(), p + 4, 8 * uint64_t(lost));
   }
