@@ -74,7 +74,7 @@ SparFit fitSpar(const Cloud& cloud, const Spar& nominal, const SparFitParams& p)
     if (std::count(seen.begin(), seen.end(), true) < 5) return kShort;
     return n + static_cast<long>(surface);
   };
-  // Vote: every 2 mm offset within the search disc; the one most points fit wins.
+  // Vote: every 2 mm offset within the search disc; the best score wins.
   const double step = 0.002;
   const int steps = static_cast<int>(std::ceil(p.search_m / step));
   Eigen::Vector2d best = Eigen::Vector2d::Zero();
