@@ -279,9 +279,13 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     ++used;
     sweep.beams += dist->values.size();
     const double first_alpha_deg = scanAngleDeg(*dist, 0);
-    const double mid = 0.5 * (scanAngleDeg(*dist, dist->values.size() - 1) - first_alpha_deg) / 360.0;
-    line_beta_deg.emplace_back(s.scan_counter, encoder ? beta0 + mid * (beta_rate + mid * beta_curve)
-                                                       : interpolateBeta(table_samples, scan_host_start + mid * period_s));
+    // β (deg) at `frac` of a mirror turn from this scan's first beam.
+    auto betaAt = [&](double frac) {
+      return encoder ? beta0 + frac * (beta_rate + frac * beta_curve)
+                     : interpolateBeta(table_samples, scan_host_start + frac * period_s);
+    };
+    line_beta_deg.emplace_back(s.scan_counter,
+                               betaAt(0.5 * (scanAngleDeg(*dist, dist->values.size() - 1) - first_alpha_deg) / 360.0));
     for (size_t i = 0; i < dist->values.size(); ++i) {
       if (dist->values[i] == 0) continue;  // no echo
       SweepPoint p;
@@ -289,9 +293,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
       p.alpha_rad = scanAngleRad(*dist, i);
       const double frac = (scanAngleDeg(*dist, i) - first_alpha_deg) / 360.0;
       p.time_s = scan_host_start + frac * period_s;
-      const double beta_deg =
-          encoder ? beta0 + frac * (beta_rate + frac * beta_curve) : interpolateBeta(table_samples, p.time_s);
-      p.beta_rad = beta_deg * kDeg;
+      p.beta_rad = betaAt(frac) * kDeg;
       if (rssi && i < rssi->values.size()) p.rssi = static_cast<uint8_t>(std::min<uint16_t>(rssi->values[i], 255));
       sweep.points.push_back(p);
     }

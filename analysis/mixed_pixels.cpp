@@ -58,35 +58,38 @@ std::vector<std::vector<uint32_t>> lineMembers(const Cloud& c) {
   return members;
 }
 
+// The median step between lines' mean β.
+double medianLineStep(const std::vector<ScanLine>& lines) {
+  std::vector<double> steps;
+  for (size_t i = 1; i < lines.size(); ++i) steps.push_back(lines[i].beta_rad - lines[i - 1].beta_rad);
+  return medianOf(steps);
+}
+
 ScanGrid scanGrid(const Cloud& c) {
   ScanGrid g;
-  std::vector<std::vector<uint32_t>> members = lineMembers(c);
-  std::vector<double> alpha_steps, mean_beta;
-  for (std::vector<uint32_t>& m : members) {
+  std::vector<ScanLine> lines = scanLines(c);
+  std::vector<double> alpha_steps;
+  for (ScanLine& line : lines) {
+    std::vector<uint32_t>& m = line.samples;
     std::sort(m.begin(), m.end(), [&](uint32_t a, uint32_t b) { return c.alpha_rad[a] < c.alpha_rad[b]; });
     for (size_t i = 1; i < m.size(); ++i) {
       const double d = c.alpha_rad[m[i]] - c.alpha_rad[m[i - 1]];
       if (d > 1e-9) alpha_steps.push_back(d);
     }
-    double b = 0;
-    for (uint32_t s : m) b += c.beta_rad[s];
-    mean_beta.push_back(b / static_cast<double>(m.size()));
   }
   g.d_alpha = medianOf(alpha_steps);
-  std::vector<double> beta_steps;
-  for (size_t i = 1; i < mean_beta.size(); ++i) beta_steps.push_back(mean_beta[i] - mean_beta[i - 1]);
-  g.d_beta = medianOf(beta_steps);
+  g.d_beta = medianLineStep(lines);
   if (!(g.d_alpha > 0)) return g;
   double alpha_min = c.alpha_rad[0];
   for (double a : c.alpha_rad) alpha_min = std::min(alpha_min, a);
-  for (size_t l = 0; l < members.size(); ++l) {
+  for (const ScanLine& scan_line : lines) {
     Row line;
-    for (uint32_t s : members[l]) {
+    for (uint32_t s : scan_line.samples) {
       const int64_t k = std::llround((c.alpha_rad[s] - alpha_min) / g.d_alpha);
       if (line.empty() || line.back().first != k) line.emplace_back(k, s);  // a second echo at one step stays off the grid
     }
     g.lines.push_back(std::move(line));
-    g.line_step.push_back(g.d_beta > 0 ? std::llround((mean_beta[l] - mean_beta[0]) / g.d_beta) : 0);
+    g.line_step.push_back(g.d_beta > 0 ? std::llround((scan_line.beta_rad - lines.front().beta_rad) / g.d_beta) : 0);
   }
   return g;
 }
@@ -244,11 +247,6 @@ std::vector<ScanLine> scanLines(const Cloud& cloud) {
   return out;
 }
 
-double scanLineStepRad(const Cloud& cloud) {
-  const std::vector<ScanLine> lines = scanLines(cloud);
-  std::vector<double> steps;
-  for (size_t i = 1; i < lines.size(); ++i) steps.push_back(lines[i].beta_rad - lines[i - 1].beta_rad);
-  return medianOf(steps);
-}
+double scanLineStepRad(const Cloud& cloud) { return medianLineStep(scanLines(cloud)); }
 
 }  // namespace sailshape
