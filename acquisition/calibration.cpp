@@ -6,8 +6,8 @@
 #include <limits>
 
 #include "acquisition/unit_config.hpp"
-#include "analysis/errors.hpp"
-#include "analysis/principal_axes.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/spatial/principal_axes.hpp"
 
 namespace sailshape {
 

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape {
 namespace {

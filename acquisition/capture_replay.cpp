@@ -6,7 +6,7 @@
 
 #include "acquisition/sweep.hpp"
 #include "acquisition/turntable_protocol.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape {
 

@@ -17,13 +17,13 @@
 
 #include "acquisition/cola.hpp"
 #include "acquisition/scan_data.hpp"
+#include "analysis/core/units.hpp"
 
 namespace sailshape {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kDeg = M_PI / 180.0;
 
 // SOPAS error numbers sent in sFA replies.
 constexpr uint16_t kErrAccessDenied = 1;
@@ -230,9 +230,9 @@ std::string ScannerEmulator::scanPayload(bool binary, bool polled, Clock::time_p
     // The mirror turns once per period: beam i fires (α_i − α_first)/360° of a period after the first.
     const auto fire = scan_start + std::chrono::microseconds(
                                        roundToInt((alpha_deg - start_deg) / 360.0 * period_s * 1e6));
-    const double beta = turntable_ ? turntable_->angleDegAt(fire) * kDeg : 0.0;
+    const double beta = turntable_ ? turntable_->angleDegAt(fire) * kRadPerDeg : 0.0;
     const Vec3 origin(0, params_.p_m * std::cos(beta + params_.theta_rad), params_.p_m * std::sin(beta + params_.theta_rad));
-    const double a = alpha_deg * kDeg;
+    const double a = alpha_deg * kRadPerDeg;
     const Vec3 dir(std::cos(a), std::sin(a) * std::cos(beta), std::sin(a) * std::sin(beta));
     const BeamReturn b = sensor_.measure(R * origin + T, R * dir, rng);
     if (b.status == ReturnStatus::Valid) {

@@ -6,8 +6,8 @@
 #include <set>
 #include <sstream>
 
-#include "analysis/errors.hpp"
-#include "analysis/mesh_io.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/io/mesh_io.hpp"
 
 namespace sailshape {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/mesh.hpp"
-#include "analysis/sail_generator.hpp"
+#include "analysis/core/mesh.hpp"
+#include "analysis/design/sail_generator.hpp"
 
 namespace sailshape {
 

@@ -4,14 +4,14 @@
 #include <cctype>
 #include <cmath>
 
-#include "analysis/errors.hpp"
-#include "analysis/cloud.hpp"
-#include "analysis/sail_outline.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/cloud.hpp"
+#include "analysis/core/units.hpp"
+#include "analysis/outline/sail_outline.hpp"
 
 namespace sailshape {
 
 namespace {
-constexpr double kDeg = M_PI / 180.0;
 }
 
 std::string scannerModelName(ScannerModel model) { return model == ScannerModel::Lms111 ? "lms111" : "lms511"; }
@@ -114,13 +114,13 @@ BeamReturn EmulatedSensor::measure(const Vec3& origin, const Vec3& direction, st
   out.true_range_m = axis.distance_m;
   out.object = static_cast<int>(axis.object);
   const double cos_inc = std::clamp(-axis.normal.dot(d), 0.0, 1.0);
-  out.incidence_deg = std::acos(cos_inc) / kDeg;
+  out.incidence_deg = std::acos(cos_inc) / kRadPerDeg;
 
   double range = axis.distance_m;
   double weight = 2.0;
   if (params_.mixed_pixels) {
     const double spread_allowed =
-        params_.mixed_pixel_depth_m + axis.distance_m * half * std::tan(std::min(out.incidence_deg, 85.0) * kDeg);
+        params_.mixed_pixel_depth_m + axis.distance_m * half * std::tan(std::min(out.incidence_deg, 85.0) * kRadPerDeg);
     double sum = 2.0 * axis.distance_m;
     bool straddles = false;
     for (int k = 0; k < 4; ++k) {
@@ -162,7 +162,7 @@ BeamReturn EmulatedSensor::measure(const Vec3& origin, const Vec3& direction, st
   }
   const MaterialResponse m = materialResponse(materials_[axis.object]);
   double sigma = m.sigma_m * params_.noise_scale * (1.0 + params_.grazing_noise_gain * x);
-  if (params_.sun_direction && d.dot(params_.sun_direction->normalized()) > std::cos(params_.sun_cone_deg * kDeg)) {
+  if (params_.sun_direction && d.dot(params_.sun_direction->normalized()) > std::cos(params_.sun_cone_deg * kRadPerDeg)) {
     sigma *= params_.sun_noise_factor;
     out.dazzled = true;
   }
@@ -175,8 +175,8 @@ BeamReturn EmulatedSensor::measure(const Vec3& origin, const Vec3& direction, st
 
 std::vector<BeamReturn> EmulatedSensor::scanLine(const ScanLineRequest& req) const {
   if (req.count == 0) throw InvalidInput("[EmulatedSensor::scanLine] count must be > 0");
-  const double first_deg = req.start_rad / kDeg;
-  const double last_deg = (req.start_rad + req.step_rad * static_cast<double>(req.count - 1)) / kDeg;
+  const double first_deg = req.start_rad / kRadPerDeg;
+  const double last_deg = (req.start_rad + req.step_rad * static_cast<double>(req.count - 1)) / kRadPerDeg;
   const double tol = 1e-6;
   if (std::min(first_deg, last_deg) < spec_.first_angle_deg - tol ||
       std::max(first_deg, last_deg) > spec_.last_angle_deg + tol)

@@ -9,13 +9,12 @@
 #include "acquisition/scan_data.hpp"
 #include "acquisition/scanner_client.hpp"
 #include "acquisition/turntable.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 namespace sailshape {
 
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 struct ReceivedScan {
   ScanData data;
@@ -50,13 +49,12 @@ std::vector<Vec3> previewPoints(const UnitConfig& unit, const ScanData& s, doubl
   const ScanChannel* dist = s.channel("DIST1");
   if (!dist) return out;
   const bool encoder = unit.beta_source == BetaSource::Encoder && !s.encoders.empty();
-  const double beta = (encoder ? encoderDeg(s) : table_deg) * kDeg;
+  const double beta = (encoder ? encoderDeg(s) : table_deg) * kRadPerDeg;
   out.reserve(dist->values.size());
   for (size_t i = 0; i < dist->values.size(); ++i)
     if (dist->values[i] != 0) out.push_back(sweepPointPosition(unit, scanRangeMm(*dist, i) / 1000.0, scanAngleRad(*dist, i), beta));
   return out;
 }
-
 
 }  // namespace
 
@@ -67,7 +65,7 @@ std::vector<double> lostLineBetas(const std::vector<std::pair<uint16_t, double>>
     const auto [c1, b1] = counter_beta_deg[k];
     const uint16_t step = static_cast<uint16_t>(c1 - c0);  // the counter wraps at 65,536
     if (b1 == b0) continue;  // the turntable stood: the lost scans repeat a line received
-    for (uint16_t j = 1; j < step; ++j) out.push_back((b0 + (b1 - b0) * j / step) * kDeg);
+    for (uint16_t j = 1; j < step; ++j) out.push_back((b0 + (b1 - b0) * j / step) * kRadPerDeg);
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -293,7 +291,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
       p.alpha_rad = scanAngleRad(*dist, i);
       const double frac = (scanAngleDeg(*dist, i) - first_alpha_deg) / 360.0;
       p.time_s = scan_host_start + frac * period_s;
-      p.beta_rad = betaAt(frac) * kDeg;
+      p.beta_rad = betaAt(frac) * kRadPerDeg;
       if (rssi && i < rssi->values.size()) p.rssi = static_cast<uint8_t>(std::min<uint16_t>(rssi->values[i], 255));
       sweep.points.push_back(p);
     }
@@ -304,8 +302,8 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
                              " scans of the sweep never arrived (gaps in the scan counter): the scan lines are "
                              "that much further apart there");
   if (!sweep.points.empty()) {
-    sweep.beta_start_deg = sweep.points.front().beta_rad / kDeg;
-    sweep.beta_end_deg = sweep.points.back().beta_rad / kDeg;
+    sweep.beta_start_deg = sweep.points.front().beta_rad / kRadPerDeg;
+    sweep.beta_end_deg = sweep.points.back().beta_rad / kRadPerDeg;
   }
   sweep.cloud.viewpoint = unit.pose.translation();
   sweep.cloud.lost_beta_rad = lostLineBetas(line_beta_deg);

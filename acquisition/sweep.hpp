@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "acquisition/unit_config.hpp"
-#include "analysis/cloud.hpp"
-#include "analysis/progress.hpp"
+#include "analysis/core/cloud.hpp"
+#include "analysis/core/progress.hpp"
 
 namespace sailshape {
 

@@ -18,7 +18,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 #include "acquisition/turntable.hpp"
 

@@ -10,7 +10,7 @@
 #include <cstring>
 #include <thread>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape {
 

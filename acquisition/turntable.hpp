@@ -7,7 +7,7 @@
 #include <string>
 
 #include "acquisition/turntable_protocol.hpp"
-#include "analysis/progress.hpp"
+#include "analysis/core/progress.hpp"
 
 namespace sailshape {
 

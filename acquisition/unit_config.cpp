@@ -6,13 +6,13 @@
 #include <set>
 #include <sstream>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 namespace sailshape {
 
 namespace {
 using nlohmann::json;
-constexpr double kDeg = M_PI / 180.0;
 
 double num(const json& j, const char* key, double fallback, const std::string& at) {
   if (!j.contains(key)) return fallback;
@@ -103,7 +103,7 @@ UnitConfig parseUnitJson(const std::string& text, const std::string& origin) {
   u.serial_device = str(j, "serial_device", u.serial_device, at);
   u.baud = static_cast<int>(num(j, "baud", u.baud, at));
   u.p_m = num(j, "p_m", u.p_m, at);
-  u.theta_rad = num(j, "theta_deg", 0.0, at) * kDeg;
+  u.theta_rad = num(j, "theta_deg", 0.0, at) * kRadPerDeg;
   if (j.contains("pose")) {
     const json& p = j.at("pose");
     if (!p.is_object()) throw InvalidInput(at + ": 'pose' must be {\"position_m\": [..], \"rpy_deg\": [..]}");
@@ -111,7 +111,7 @@ UnitConfig parseUnitJson(const std::string& text, const std::string& origin) {
       if (it.key() != "position_m" && it.key() != "rpy_deg") throw InvalidInput(at + ": unknown pose key '" + it.key() + "'");
     const Vec3 pos = p.contains("position_m") ? triple(p, "position_m", at) : Vec3::Zero();
     const Vec3 rpy = p.contains("rpy_deg") ? triple(p, "rpy_deg", at) : Vec3::Zero();
-    u.pose = makePose(pos, rpy.x() * kDeg, rpy.y() * kDeg, rpy.z() * kDeg);
+    u.pose = makePose(pos, rpy.x() * kRadPerDeg, rpy.y() * kRadPerDeg, rpy.z() * kRadPerDeg);
   }
   u.start_angle_deg = num(j, "start_angle_deg", u.start_angle_deg, at);
   u.sweep_angle_deg = num(j, "sweep_angle_deg", u.sweep_angle_deg, at);
@@ -156,8 +156,8 @@ std::string unitToJson(const UnitConfig& u) {
          {"serial_device", u.serial_device},
          {"baud", u.baud},
          {"p_m", u.p_m},
-         {"theta_deg", u.theta_rad / kDeg},
-         {"pose", {{"position_m", {t.x(), t.y(), t.z()}}, {"rpy_deg", {roll / kDeg, pitch / kDeg, yaw / kDeg}}}},
+         {"theta_deg", u.theta_rad / kRadPerDeg},
+         {"pose", {{"position_m", {t.x(), t.y(), t.z()}}, {"rpy_deg", {roll / kRadPerDeg, pitch / kRadPerDeg, yaw / kRadPerDeg}}}},
          {"start_angle_deg", u.start_angle_deg},
          {"sweep_angle_deg", u.sweep_angle_deg},
          {"speed_deg_s", u.speed_deg_s},

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "acquisition/sensor_model.hpp"
-#include "analysis/cloud.hpp"
+#include "analysis/core/cloud.hpp"
 
 namespace sailshape {
 

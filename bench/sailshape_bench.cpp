@@ -33,16 +33,16 @@
 #include "acquisition/ray_caster.hpp"
 #include "acquisition/scene.hpp"
 #include "acquisition/sensor_model.hpp"
-#include "analysis/cleaning.hpp"
-#include "analysis/design_compare.hpp"
-#include "analysis/normals.hpp"
-#include "analysis/pipeline.hpp"
-#include "analysis/registration.hpp"
-#include "analysis/sail_generator.hpp"
-#include "analysis/segmentation.hpp"
-#include "analysis/smoothing.hpp"
-#include "analysis/surface.hpp"
-#include "analysis/tunnel_scene.hpp"
+#include "analysis/segmentation/cleaning.hpp"
+#include "analysis/design/design_compare.hpp"
+#include "analysis/spatial/normals.hpp"
+#include "analysis/pipeline/pipeline.hpp"
+#include "analysis/registration/registration.hpp"
+#include "analysis/design/sail_generator.hpp"
+#include "analysis/segmentation/segmentation.hpp"
+#include "analysis/surface/smoothing.hpp"
+#include "analysis/surface/surface.hpp"
+#include "tests/support/tunnel_scene.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"
 #include "database/schema.hpp"
@@ -342,7 +342,6 @@ void BM_Ours_SignedDistance(benchmark::State& state) {
   state.counters["design_triangles"] = static_cast<double>(mesh.triangles.size());
   finish(state, c.size());
 }
-
 
 // ---- registration (issue 5): the two-unit tunnel scene at about 200,000 points per unit ----
 // Plane method (detection in both clouds, matching, crossed filter, anchored

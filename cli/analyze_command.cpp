@@ -5,12 +5,12 @@
 #include <memory>
 
 #include "acquisition/sensor_model.hpp"
-#include "analysis/analysis_json.hpp"
-#include "analysis/cloud_io.hpp"
-#include "analysis/errors.hpp"
-#include "analysis/mesh_io.hpp"
-#include "analysis/params_io.hpp"
-#include "analysis/pipeline.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/io/mesh_io.hpp"
+#include "analysis/pipeline/params_io.hpp"
+#include "analysis/pipeline/pipeline.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"
 #include "cli/progress_bar.hpp"

@@ -16,16 +16,17 @@
 #include "acquisition/sweep.hpp"
 #include "acquisition/sync.hpp"
 #include "acquisition/unit_config.hpp"
-#include "analysis/analysis_json.hpp"
-#include "analysis/boat_registration.hpp"
-#include "analysis/cloud_io.hpp"
-#include "analysis/design_compare.hpp"
-#include "analysis/errors.hpp"
-#include "analysis/pipeline.hpp"
-#include "analysis/registration.hpp"
-#include "analysis/rigid_transform.hpp"
-#include "analysis/sail_generator.hpp"
-#include "analysis/spars.hpp"
+#include "analysis/core/units.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
+#include "analysis/registration/boat_registration.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/design/design_compare.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/pipeline/pipeline.hpp"
+#include "analysis/registration/registration.hpp"
+#include "analysis/registration/rigid_transform.hpp"
+#include "analysis/design/sail_generator.hpp"
+#include "analysis/segmentation/spars.hpp"
 #include "database/catalog.hpp"
 #include "database/import.hpp"
 #include "database/schema.hpp"
@@ -36,7 +37,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kModelScale = 1.0 / 3.6;  // the built-in tunnel's yacht model
 const char* const kTest = "A2 tack ease";
 
@@ -138,7 +138,7 @@ struct RigUnit {
 // Shaft vertical (unit X = boat +Z), the scan fan looking horizontally along `look` at β = 0.
 Eigen::Isometry3d verticalShaftPose(const Vec3& position, double look_deg) {
   const Vec3 x = Vec3::UnitZ();
-  const Vec3 y(std::cos(look_deg * kDeg), std::sin(look_deg * kDeg), 0.0);
+  const Vec3 y(std::cos(look_deg * kRadPerDeg), std::sin(look_deg * kRadPerDeg), 0.0);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear().col(0) = x;
   pose.linear().col(1) = y;
@@ -150,7 +150,7 @@ Eigen::Isometry3d verticalShaftPose(const Vec3& position, double look_deg) {
 // A hand-placed unit is never quite where the drawing puts it: a few centimetres and degrees.
 Eigen::Isometry3d placementError(const Vec3& offset, double yaw_deg, double tilt_deg) {
   Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
-  e.linear() = (Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitZ()) * Eigen::AngleAxisd(tilt_deg * kDeg, Vec3::UnitX()))
+  e.linear() = (Eigen::AngleAxisd(yaw_deg * kRadPerDeg, Vec3::UnitZ()) * Eigen::AngleAxisd(tilt_deg * kRadPerDeg, Vec3::UnitX()))
                    .toRotationMatrix();
   e.translation() = offset;
   return e;
@@ -163,7 +163,7 @@ std::vector<RigUnit> makeRig(const DemoOptions& o, const SectionParams& sections
   rig[0].config.model = ScannerModel::Lms511;
   rig[0].config.pose = verticalShaftPose(Vec3(-0.5, -3.0, 1.1), 90.0);
   rig[0].config.p_m = 0.105;
-  rig[0].config.theta_rad = 8.0 * kDeg;
+  rig[0].config.theta_rad = 8.0 * kRadPerDeg;
   rig[0].true_pose = placementError(Vec3(0.03, -0.02, 0.01), 1.2, 0.4) * rig[0].config.pose;
   rig[0].sail = "Demo 36 main";
   rig[0].sail_file = "main";
@@ -174,7 +174,7 @@ std::vector<RigUnit> makeRig(const DemoOptions& o, const SectionParams& sections
   rig[1].config.model = ScannerModel::Lms111;
   rig[1].config.pose = verticalShaftPose(Vec3(3.7, 3.4, 1.2), -135.0);
   rig[1].config.p_m = 0.095;
-  rig[1].config.theta_rad = -6.0 * kDeg;
+  rig[1].config.theta_rad = -6.0 * kRadPerDeg;
   rig[1].true_pose = placementError(Vec3(-0.02, 0.03, -0.015), -0.8, -0.5) * rig[1].config.pose;
   rig[1].sail = "Demo 36 A2";
   rig[1].sail_file = "a2";
@@ -224,8 +224,6 @@ struct EmulatedUnit {
   }
 };
 
-
-
 // The region of interest a crew draws around each sail (study §5.4): the designed
 // sail's bounding box grown by `margin_m`, less the deck and a clearance of
 // `clearance_m` around the spars, whose points region growing cannot always tell
@@ -263,7 +261,7 @@ Forces simulatedForces(const std::vector<std::pair<double, double>>& area_camber
                        const std::vector<double>& centre_heights_m) {
   const double q = 0.5 * 1.2 * 6.0 * 6.0;
   Forces f;
-  const double b = awa_deg * kDeg;
+  const double b = awa_deg * kRadPerDeg;
   for (size_t i = 0; i < area_camber.size(); ++i) {
     const auto [area, camber] = area_camber[i];
     const double cl = std::min(1.7, 0.6 + 5.5 * camber);

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/progress.hpp"
+#include "analysis/core/progress.hpp"
 
 namespace sailshape::cli {
 

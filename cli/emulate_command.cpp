@@ -14,7 +14,7 @@
 #include "acquisition/scanner_emulator.hpp"
 #include "acquisition/scene.hpp"
 #include "acquisition/unit_config.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "cli/commands.hpp"
 
 namespace sailshape::cli {

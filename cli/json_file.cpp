@@ -2,7 +2,7 @@
 
 #include <fstream>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape::cli {
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <exception>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "cli/commands.hpp"
 
 int main(int argc, char** argv) {

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <string>
 
-#include "analysis/progress.hpp"
+#include "analysis/core/progress.hpp"
 
 namespace sailshape::cli {
 

@@ -7,11 +7,11 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "analysis/boat_registration.hpp"
-#include "analysis/cloud_io.hpp"
-#include "analysis/errors.hpp"
-#include "analysis/registration.hpp"
-#include "analysis/rigid_transform.hpp"
+#include "analysis/registration/boat_registration.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/registration/registration.hpp"
+#include "analysis/registration/rigid_transform.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"
 #include "cli/progress_bar.hpp"

@@ -5,7 +5,7 @@
 
 #include "acquisition/capture_replay.hpp"
 #include "acquisition/unit_config.hpp"
-#include "analysis/cloud_io.hpp"
+#include "analysis/io/cloud_io.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"
 #include "cli/progress_bar.hpp"

@@ -2,7 +2,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "cli/commands.hpp"
 #include "cli/progress_bar.hpp"
 #include "reports/trim_report.hpp"

@@ -9,14 +9,13 @@
 #include "acquisition/calibration.hpp"
 #include "acquisition/sweep_io.hpp"
 #include "acquisition/unit_config.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"
 
 namespace sailshape::cli {
 namespace {
-
-constexpr double kDeg = M_PI / 180;
 
 struct CalibrateOptions {
   std::vector<std::string> planes;
@@ -76,7 +75,7 @@ void run(const CalibrateOptions& o) {
     params.initial_theta_rad = unit.theta_rad;
   }
   if (o.p0_set) params.initial_p_m = o.p0;
-  if (o.theta0_set) params.initial_theta_rad = o.theta0_deg * kDeg;
+  if (o.theta0_set) params.initial_theta_rad = o.theta0_deg * kRadPerDeg;
   std::vector<CalibrationTarget> targets;
   for (const std::string& p : o.planes) targets.push_back(loadTarget(p, params.initial_p_m, params.initial_theta_rad));
   for (size_t i = 0; i < o.cylinders.size(); ++i) {
@@ -87,7 +86,7 @@ void run(const CalibrateOptions& o) {
   }
   const CalibrationResult r = calibrateUnit(targets, params);
   std::printf("p = %.2f mm ± %.2f mm, theta = %.3f deg ± %.3f deg (%s after %d iterations)\n", r.p_m * 1000,
-              r.p_stderr_m * 1000, r.theta_rad / kDeg, r.theta_stderr_rad / kDeg,
+              r.p_stderr_m * 1000, r.theta_rad / kRadPerDeg, r.theta_stderr_rad / kRadPerDeg,
               r.converged ? "converged" : "NOT converged", r.iterations);
   std::printf("%-40s %8s %8s %10s %10s\n", "target", "points", "dropped", "rms mm", "max mm");
   for (const CalibrationTargetResult& t : r.targets)
@@ -96,9 +95,9 @@ void run(const CalibrateOptions& o) {
   for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (!o.json.empty()) {
     nlohmann::json doc{{"p_m", r.p_m},
-                       {"theta_deg", r.theta_rad / kDeg},
+                       {"theta_deg", r.theta_rad / kRadPerDeg},
                        {"p_stderr_m", r.p_stderr_m},
-                       {"theta_stderr_deg", r.theta_stderr_rad / kDeg},
+                       {"theta_stderr_deg", r.theta_stderr_rad / kRadPerDeg},
                        {"rms_m", r.rms_m},
                        {"converged", r.converged},
                        {"iterations", r.iterations},

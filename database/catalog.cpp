@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape {
 namespace {

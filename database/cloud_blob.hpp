@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "analysis/cloud.hpp"
+#include "analysis/core/cloud.hpp"
 
 namespace sailshape {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/cloud_blob.hpp"
 
 namespace sailshape {

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/cloud.hpp"
+#include "analysis/core/cloud.hpp"
 #include "database/sqlite.hpp"
 
 namespace sailshape {

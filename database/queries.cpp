@@ -4,7 +4,7 @@
 #include <cmath>
 #include <map>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/scan_record.hpp"
 
 namespace sailshape {

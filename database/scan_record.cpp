@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/catalog.hpp"
 #include "database/cloud_blob.hpp"
 #include "database/import.hpp"

@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/cloud.hpp"
-#include "analysis/sections.hpp"
+#include "analysis/core/cloud.hpp"
+#include "analysis/sections/sections.hpp"
 #include "database/sqlite.hpp"
 
 namespace sailshape {

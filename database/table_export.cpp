@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <fstream>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape {
 namespace {

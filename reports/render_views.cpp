@@ -22,7 +22,7 @@
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 // LeakSanitizer's switch, present only in sanitizer builds (weak: null otherwise).
 extern "C" void __lsan_disable() __attribute__((weak));

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "analysis/mesh.hpp"
+#include "analysis/core/mesh.hpp"
 
 namespace sailshape {
 

@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/catalog.hpp"
 #include "database/cloud_blob.hpp"
 #include "database/import.hpp"

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "analysis/cloud.hpp"
-#include "analysis/luff_curve.hpp"
-#include "analysis/mesh.hpp"
-#include "analysis/sections.hpp"
+#include "analysis/core/cloud.hpp"
+#include "analysis/sections/luff_curve.hpp"
+#include "analysis/core/mesh.hpp"
+#include "analysis/sections/sections.hpp"
 #include "database/sqlite.hpp"
 
 namespace sailshape {

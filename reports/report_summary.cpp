@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <map>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape {
 namespace {

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/sections.hpp"
+#include "analysis/sections/sections.hpp"
 
 namespace sailshape {
 

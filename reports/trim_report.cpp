@@ -10,7 +10,7 @@
 #include <limits>
 #include <set>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/schema.hpp"
 #include "reports/private_display.hpp"
 

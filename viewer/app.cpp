@@ -8,13 +8,13 @@
 #include <filesystem>
 #include <iostream>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/catalog.hpp"
 #include "database/scan_record.hpp"
 #include "database/schema.hpp"
 #include "acquisition/scene.hpp"
 #include "acquisition/sensor_model.hpp"
-#include "analysis/sail_generator.hpp"
+#include "analysis/design/sail_generator.hpp"
 #include "reports/trim_report.hpp"
 
 namespace sailshape::viewer {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "analysis/analysis_json.hpp"
-#include "analysis/errors.hpp"
-#include "analysis/params_io.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/pipeline/params_io.hpp"
 #include "database/import.hpp"
 #include "viewer/unit_camera.hpp"
 

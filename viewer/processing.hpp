@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/pipeline.hpp"
+#include "analysis/pipeline/pipeline.hpp"
 #include "database/sqlite.hpp"
 
 namespace sailshape {

@@ -2,7 +2,7 @@
 
 #include <numeric>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "viewer/worker.hpp"
 
 namespace sailshape::viewer {

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/design_compare.hpp"
-#include "analysis/pipeline.hpp"
+#include "analysis/design/design_compare.hpp"
+#include "analysis/pipeline/pipeline.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/processing.hpp"
 

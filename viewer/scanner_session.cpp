@@ -8,7 +8,7 @@
 #include "acquisition/scene.hpp"
 #include "acquisition/sync.hpp"
 #include "acquisition/turntable.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape::viewer {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/design_compare.hpp"
-#include "analysis/sections.hpp"
+#include "analysis/design/design_compare.hpp"
+#include "analysis/sections/sections.hpp"
 
 namespace sailshape::viewer {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "acquisition/sweep.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape::viewer {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/cloud.hpp"
+#include "analysis/core/cloud.hpp"
 #include "viewer/unit_camera.hpp"
 
 namespace sailshape::viewer {

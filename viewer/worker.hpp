@@ -12,7 +12,7 @@
 #include <string>
 #include <thread>
 
-#include "analysis/progress.hpp"
+#include "analysis/core/progress.hpp"
 
 namespace sailshape::viewer {
 

@@ -7,14 +7,14 @@
 #include "acquisition/emulated_turntable.hpp"
 #include "acquisition/scanner_emulator.hpp"
 #include "acquisition/sensor_model.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 using namespace sailshape;
 
 namespace {
 
-constexpr double kDeg = M_PI / 180;
-constexpr double kTrueP = 0.105, kTrueTheta = 12 * kDeg;
+constexpr double kTrueP = 0.105, kTrueTheta = 12 * kRadPerDeg;
 
 // A wall y = 3 and a floor z = −1.5 in the unit frame (cloth, so σ = 4.1 mm), optionally a post.
 Scene room(bool with_post = false) {
@@ -44,9 +44,9 @@ std::vector<CalibrationTarget> emulatedTargets(const Scene& scene, double beta_f
     }
   }
   std::mt19937_64 rng(2024);
-  for (double beta = beta_from_deg * kDeg; beta <= beta_to_deg * kDeg; beta += beta_step_deg * kDeg) {
+  for (double beta = beta_from_deg * kRadPerDeg; beta <= beta_to_deg * kRadPerDeg; beta += beta_step_deg * kRadPerDeg) {
     const Vec3 origin(0, kTrueP * std::cos(beta + kTrueTheta), kTrueP * std::sin(beta + kTrueTheta));
-    for (double a = -5 * kDeg; a <= 185 * kDeg; a += 1 * kDeg) {
+    for (double a = -5 * kRadPerDeg; a <= 185 * kRadPerDeg; a += 1 * kRadPerDeg) {
       const Vec3 dir(std::cos(a), std::sin(a) * std::cos(beta), std::sin(a) * std::sin(beta));
       const BeamReturn b = sensor.measure(origin, dir, rng);
       if (b.status != ReturnStatus::Valid || b.mixed) continue;
@@ -68,15 +68,15 @@ TEST(Calibration, WallAndFloorRecoverPAndTheta) {
   const CalibrationResult r = calibrateUnit(targets, cp);
   EXPECT_TRUE(r.converged);
   EXPECT_NEAR(r.p_m, kTrueP, 0.002);
-  EXPECT_NEAR(r.theta_rad, kTrueTheta, 0.1 * kDeg);
+  EXPECT_NEAR(r.theta_rad, kTrueTheta, 0.1 * kRadPerDeg);
   // Residuals: the cloth noise (SPEC §3: 4.1 mm along the beam, less across an oblique plane) plus the
   // bending the 0.2 %·r systematic error leaves.
   EXPECT_LT(r.rms_m, 1.5 * 0.0041);
   ASSERT_EQ(r.targets.size(), 2u);
-  EXPECT_GT(std::abs(r.targets[0].normal.y()), std::cos(0.2 * kDeg));
-  EXPECT_GT(std::abs(r.targets[1].normal.z()), std::cos(0.2 * kDeg));
+  EXPECT_GT(std::abs(r.targets[0].normal.y()), std::cos(0.2 * kRadPerDeg));
+  EXPECT_GT(std::abs(r.targets[1].normal.z()), std::cos(0.2 * kRadPerDeg));
   EXPECT_LT(r.p_stderr_m, 0.002);
-  EXPECT_LT(r.theta_stderr_rad, 0.05 * kDeg);
+  EXPECT_LT(r.theta_stderr_rad, 0.05 * kRadPerDeg);
   EXPECT_TRUE(r.warnings.empty());
 }
 
@@ -85,13 +85,13 @@ TEST(Calibration, CylinderOfKnownRadiusWithAPlane) {
   ASSERT_EQ(targets.size(), 3u);
   ASSERT_GT(targets[2].samples.size(), 500u);
   const CalibrationResult r = calibrateUnit(targets, {});
-  EXPECT_LT(r.theta_stderr_rad, 0.05 * kDeg);
+  EXPECT_LT(r.theta_stderr_rad, 0.05 * kRadPerDeg);
   EXPECT_NEAR(r.p_m, kTrueP, 0.002);
-  EXPECT_NEAR(r.theta_rad, kTrueTheta, 0.1 * kDeg);
+  EXPECT_NEAR(r.theta_rad, kTrueTheta, 0.1 * kRadPerDeg);
   ASSERT_EQ(r.targets.size(), 3u);
   EXPECT_LT(r.targets[2].rms_m, 1.5 * 0.0041);
   // The fitted axis is the post's: vertical through (0.8, 1.2).
-  EXPECT_GT(std::abs(r.targets[2].normal.z()), std::cos(0.5 * kDeg));
+  EXPECT_GT(std::abs(r.targets[2].normal.z()), std::cos(0.5 * kRadPerDeg));
   const Vec3 c = r.targets[2].point;
   const Vec3 n = r.targets[2].normal;
   const Vec3 on_axis = c + n * ((-1.0 - c.z()) / n.z());
@@ -103,7 +103,7 @@ TEST(Calibration, NarrowSingleWallIsFlaggedAsPoorlyDetermined) {
   auto targets = emulatedTargets(room(), -15, 15);
   targets.resize(1);  // the wall only
   const CalibrationResult r = calibrateUnit(targets, {});
-  EXPECT_GT(r.theta_stderr_rad, 0.5 * kDeg);
+  EXPECT_GT(r.theta_stderr_rad, 0.5 * kRadPerDeg);
   ASSERT_FALSE(r.warnings.empty());
   EXPECT_NE(r.warnings.back().find("poorly determined"), std::string::npos);
 }
@@ -147,7 +147,7 @@ TEST(Calibration, EndToEndThroughTheEmulatedUnit) {
   ASSERT_GT(floor.samples.size(), 3000u);
   const CalibrationResult r = calibrateUnit({wall, floor}, {});
   EXPECT_NEAR(r.p_m, kTrueP, 0.002);
-  EXPECT_NEAR(r.theta_rad, kTrueTheta, 0.1 * kDeg);
+  EXPECT_NEAR(r.theta_rad, kTrueTheta, 0.1 * kRadPerDeg);
   EXPECT_LT(r.rms_m, 1.5 * 0.0041);
 }
 

@@ -12,7 +12,7 @@
 
 #include "acquisition/capture_replay.hpp"
 #include "acquisition/turntable_protocol.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape {
 namespace {

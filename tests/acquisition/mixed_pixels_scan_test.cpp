@@ -13,16 +13,15 @@
 
 #include "acquisition/scene.hpp"
 #include "acquisition/sensor_model.hpp"
-#include "analysis/cloud_io.hpp"
-#include "analysis/mixed_pixels.hpp"
-#include "analysis/pipeline.hpp"
-#include "analysis/sail_generator.hpp"
+#include "analysis/core/units.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/segmentation/mixed_pixels.hpp"
+#include "analysis/pipeline/pipeline.hpp"
+#include "analysis/design/sail_generator.hpp"
 
 using namespace sailshape;
 
 namespace {
-
-constexpr double kDeg = M_PI / 180;
 
 struct SweptScan {
   Cloud cloud;
@@ -38,12 +37,12 @@ SweptScan sweep(const Scene& scene, double beta_step) {
   SweptScan s;
   s.cloud.viewpoint = Vec3::Zero();
   uint64_t seed = 1;
-  for (double beta = -20 * kDeg; beta <= 20 * kDeg; beta += beta_step) {
+  for (double beta = -20 * kRadPerDeg; beta <= 20 * kRadPerDeg; beta += beta_step) {
     ScanLineRequest r;
     r.axis_x = Vec3::UnitX();
     r.axis_y = Vec3(0, std::cos(beta), std::sin(beta));
-    r.start_rad = 70 * kDeg;
-    r.step_rad = kDeg / 6;
+    r.start_rad = 70 * kRadPerDeg;
+    r.step_rad = kRadPerDeg / 6;
     r.count = 241;
     r.seed = seed++;
     const std::vector<BeamReturn> line = sensor.scanLine(r);
@@ -73,7 +72,7 @@ Scene panelBeforeSailBeforeWall() {
 }  // namespace
 
 TEST(MixedPixelsOnAnEmulatedSweep, TheFringeBehindAPanelsEdgeGoesAndThePanelsStay) {
-  for (double beta_step : {kDeg / 6, kDeg / 3}) {
+  for (double beta_step : {kRadPerDeg / 6, kRadPerDeg / 3}) {
     const SweptScan s = sweep(panelBeforeSailBeforeWall(), beta_step);
     // The range offset a clean return carries (systematic error, cloth), off the straddling ones.
     std::vector<double> offsets;
@@ -104,9 +103,9 @@ TEST(MixedPixelsOnAnEmulatedSweep, TheFringeBehindAPanelsEdgeGoesAndThePanelsSta
     // near side reaches the threshold only for one straddling ray of 0.3 m (5 cm),
     // so an odd one stays where two such edges meet. (Lines 1/3° apart see the rim
     // in fewer, larger steps.)
-    EXPECT_GE(static_cast<double>(far_removed), 0.97 * static_cast<double>(far)) << "β step " << beta_step / kDeg << "°";
+    EXPECT_GE(static_cast<double>(far_removed), 0.97 * static_cast<double>(far)) << "β step " << beta_step / kRadPerDeg << "°";
     // A clean return goes only on 5 σ of noise on both sides of it.
-    EXPECT_LE(static_cast<double>(clean_removed), 0.001 * static_cast<double>(clean)) << "β step " << beta_step / kDeg << "°";
+    EXPECT_LE(static_cast<double>(clean_removed), 0.001 * static_cast<double>(clean)) << "β step " << beta_step / kRadPerDeg << "°";
   }
 }
 

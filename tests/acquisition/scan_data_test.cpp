@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "acquisition/capture.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 namespace sailshape {
 namespace {

@@ -20,13 +20,12 @@
 #include "acquisition/cola.hpp"
 #include "acquisition/scan_data.hpp"
 #include "acquisition/scanner_emulator.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 using namespace sailshape;
 
 namespace {
-
-constexpr double kDeg = M_PI / 180;
 
 // A raw CoLa connection for the tests (the product's client is tested elsewhere).
 class RawCola {
@@ -364,5 +363,5 @@ TEST(ScannerEmulator, BetaFollowsTheTurntable) {
   const size_t i90 = static_cast<size_t>(std::lround((90.0 - scanAngleDeg(*dist, 0)) / (dist->angular_step / 10000.0)));
   const double alpha = scanAngleRad(*dist, i90);
   // Beam direction (cos α, sin α cos β, sin α sin β): z-component sin α sin(-60°).
-  EXPECT_NEAR(scanRangeMm(*dist, i90) / 1000.0, 2.0 / (std::sin(alpha) * std::sin(60 * kDeg)), 0.0015);
+  EXPECT_NEAR(scanRangeMm(*dist, i90) / 1000.0, 2.0 / (std::sin(alpha) * std::sin(60 * kRadPerDeg)), 0.0015);
 }

@@ -7,7 +7,7 @@
 
 #include "acquisition/ray_caster.hpp"
 #include "acquisition/scene.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 using namespace sailshape;
 

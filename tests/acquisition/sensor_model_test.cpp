@@ -6,13 +6,12 @@
 #include <numeric>
 
 #include "acquisition/sensor_model.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 using namespace sailshape;
 
 namespace {
-
-constexpr double kDeg = M_PI / 180;
 
 // A large plane through `point` with unit normal `normal`, as one quad.
 Scene planeScene(const Vec3& point, const Vec3& normal, Material material, double half = 40) {
@@ -48,8 +47,8 @@ TEST(SensorModel, PlaneAtFiveMetresHasClothNoiseAndLinearBias) {
     ScanLineRequest r;
     r.axis_x = Vec3(0, -1, 0);
     r.axis_y = Vec3(1, 0, 0);
-    r.start_rad = 80 * kDeg;
-    r.step_rad = (1.0 / 6.0) * kDeg;
+    r.start_rad = 80 * kRadPerDeg;
+    r.step_rad = (1.0 / 6.0) * kRadPerDeg;
     r.count = 121;
     r.seed = 100 + line;
     for (const BeamReturn& b : sensor.scanLine(r)) {
@@ -64,7 +63,7 @@ TEST(SensorModel, PlaneAtFiveMetresHasClothNoiseAndLinearBias) {
   ASSERT_DOUBLE_EQ(sigma, 0.0041);  // SPEC §3: sail cloth ≈ 4.1 mm
   // Systematic part: positive, within SPEC's 0.3 % of range, and the model's own fraction.
   EXPECT_GT(e.mean, 0.0);
-  EXPECT_LT(e.mean, 0.003 * 5.0 / std::cos(10 * kDeg));
+  EXPECT_LT(e.mean, 0.003 * 5.0 / std::cos(10 * kRadPerDeg));
   EXPECT_NEAR(r.mean, 0.0, 4 * sigma / std::sqrt(r.n));
   // σ estimate from n = 2420 samples has a relative standard error of 1/sqrt(2n) ≈ 1.4 %.
   EXPECT_NEAR(r.sd, sigma, 0.07 * sigma);
@@ -91,7 +90,7 @@ TEST(SensorModel, SystematicErrorGrowsLinearlyWithDistance) {
 TEST(SensorModel, IncidenceDropouts) {
   SensorModelParams p;
   const auto returnsAt = [&](double incidence_deg, int beams) {
-    const Vec3 n(-std::cos(incidence_deg * kDeg), std::sin(incidence_deg * kDeg), 0);
+    const Vec3 n(-std::cos(incidence_deg * kRadPerDeg), std::sin(incidence_deg * kRadPerDeg), 0);
     const EmulatedSensor sensor(planeScene(Vec3(6, 0, 0), n, Material::Cloth), p);
     std::mt19937_64 rng(3);
     int valid = 0;
@@ -141,8 +140,8 @@ ScanLineRequest acrossThePanelsEdge() {
   ScanLineRequest r;
   r.axis_x = Vec3(0, -1, 0);
   r.axis_y = Vec3(1, 0, 0);
-  r.start_rad = 88 * kDeg;
-  r.step_rad = 0.02 * kDeg;
+  r.start_rad = 88 * kRadPerDeg;
+  r.step_rad = 0.02 * kRadPerDeg;
   r.count = 201;
   return r;
 }
@@ -165,7 +164,7 @@ TEST(SensorModel, MixedPixelsAtASilhouetteEdge) {
     if (b.mixed) {
       if (b.range_m > 3.0 + tol && b.range_m < 6.0 - tol) ++mixed_between;
     } else {
-      EXPECT_TRUE(std::abs(b.range_m - 3.0 / std::abs(std::sin(88 * kDeg))) < 0.1 ||
+      EXPECT_TRUE(std::abs(b.range_m - 3.0 / std::abs(std::sin(88 * kRadPerDeg))) < 0.1 ||
                   std::abs(b.range_m - 6.0) < 0.2)
           << b.range_m;
     }
@@ -205,13 +204,13 @@ TEST(SensorModel, AgainstTheSkyAnEdgeReturnsAsFarAsTheBeamsAxis) {
     if (i == 100) continue;  // the axis exactly on the edge
     const double a = r.start_rad + r.step_rad * static_cast<double>(i);
     const BeamReturn& b = line[i];
-    if (a < 90 * kDeg) {  // the axis (sin a, −cos a, 0) meets the panel's plane at y < 0
-      ASSERT_EQ(b.status, ReturnStatus::Valid) << "beam at " << a / kDeg << "°";
+    if (a < 90 * kRadPerDeg) {  // the axis (sin a, −cos a, 0) meets the panel's plane at y < 0
+      ASSERT_EQ(b.status, ReturnStatus::Valid) << "beam at " << a / kRadPerDeg << "°";
       EXPECT_NEAR(b.range_m - offset, 3.0 / std::sin(a), 0.002) << "a straddling beam still reads the panel's range";
       ++on_panel;
       straddling += b.mixed;
     } else {
-      EXPECT_NE(b.status, ReturnStatus::Valid) << "beam at " << a / kDeg << "°: nothing behind to return from";
+      EXPECT_NE(b.status, ReturnStatus::Valid) << "beam at " << a / kRadPerDeg << "°: nothing behind to return from";
     }
   }
   EXPECT_EQ(on_panel, 100);
@@ -239,7 +238,7 @@ TEST(SensorModel, RssiFollowsMaterialAndIncidence) {
   SensorModelParams p;
   p.mixed_pixels = false;
   const auto rssi = [&](Material m, double inc_deg) {
-    const Vec3 n(-std::cos(inc_deg * kDeg), std::sin(inc_deg * kDeg), 0);
+    const Vec3 n(-std::cos(inc_deg * kRadPerDeg), std::sin(inc_deg * kRadPerDeg), 0);
     std::mt19937_64 rng(1);
     return EmulatedSensor(planeScene(Vec3(5, 0, 0), n, m), p).measure(Vec3::Zero(), Vec3::UnitX(), rng).rssi;
   };
@@ -254,8 +253,8 @@ TEST(SensorModel, SeededAndRepeatable) {
   ScanLineRequest r;
   r.axis_x = Vec3(0, -1, 0);
   r.axis_y = Vec3(1, 0, 0);
-  r.start_rad = 85 * kDeg;
-  r.step_rad = 0.5 * kDeg;
+  r.start_rad = 85 * kRadPerDeg;
+  r.step_rad = 0.5 * kRadPerDeg;
   r.count = 20;
   r.seed = 5;
   const auto a = sensor.scanLine(r), b = sensor.scanLine(r);
@@ -288,11 +287,11 @@ TEST(SensorModel, BadParametersAndFieldOfView) {
   EXPECT_THROW(EmulatedSensor(s, p), InvalidInput);
   const EmulatedSensor lms511(s, {});
   ScanLineRequest r;
-  r.start_rad = -10 * kDeg;  // LMS511 starts at -5°
-  r.step_rad = 1 * kDeg;
+  r.start_rad = -10 * kRadPerDeg;  // LMS511 starts at -5°
+  r.step_rad = 1 * kRadPerDeg;
   r.count = 10;
   EXPECT_THROW(lms511.scanLine(r), InvalidInput);
-  r.start_rad = 180 * kDeg;  // ends at 189° > 185°
+  r.start_rad = 180 * kRadPerDeg;  // ends at 189° > 185°
   EXPECT_THROW(lms511.scanLine(r), InvalidInput);
   r.start_rad = 0;
   r.count = 0;

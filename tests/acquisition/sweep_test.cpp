@@ -12,14 +12,14 @@
 #include "acquisition/scanner_emulator.hpp"
 #include "acquisition/sweep.hpp"
 #include "acquisition/turntable.hpp"
-#include "analysis/errors.hpp"
-#include "analysis/mixed_pixels.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
+#include "analysis/segmentation/mixed_pixels.hpp"
 
 using namespace sailshape;
 
 namespace {
 
-constexpr double kDeg = M_PI / 180;
 constexpr double kSigmaCloth = 0.0041;  // SPEC §3
 
 // One emulated unit: drive on a pty, scanner on an ephemeral port, sharing the drive's motion.
@@ -47,7 +47,7 @@ UnitConfig compactUnit(double p_m, double theta_deg) {
   u.name = "test-unit";
   u.model = ScannerModel::Lms511;
   u.p_m = p_m;
-  u.theta_rad = theta_deg * kDeg;
+  u.theta_rad = theta_deg * kRadPerDeg;
   u.frequency_hz = 50;
   u.resolution_deg = 1.0;
   u.output_start_deg = 60;
@@ -123,14 +123,14 @@ void checkPlaneSweep(BetaSource source, const std::string& protocol = "cola-b", 
   EXPECT_LE(f.rms, 1.5 * kSigmaCloth) << "plane RMS residual";
   // The fitted plane is the true one (normal along the pose's Y), offset by at most the systematic error.
   const Vec3 n_true = u.pose.linear() * Vec3::UnitY();
-  EXPECT_GT(std::abs(f.normal.dot(n_true)), std::cos(0.2 * kDeg));
+  EXPECT_GT(std::abs(f.normal.dot(n_true)), std::cos(0.2 * kRadPerDeg));
   const double offset = (f.centroid - u.pose * Vec3(0, 3, 0)).dot(n_true);
   EXPECT_GT(offset, -3 * kSigmaCloth / std::sqrt(double(s.points.size())));
   EXPECT_LT(offset, 0.003 * 3.6);  // SPEC §3: ≤ 0.3 % of the longest range (3 m / sin 60° ≈ 3.5 m)
   // Samples keep r, α, β, RSSI and time.
   for (const SweepPoint& p : s.points) {
-    ASSERT_GE(p.alpha_rad, 60 * kDeg - 1e-9);
-    ASSERT_LE(p.alpha_rad, 120 * kDeg + 1e-9);
+    ASSERT_GE(p.alpha_rad, 60 * kRadPerDeg - 1e-9);
+    ASSERT_LE(p.alpha_rad, 120 * kRadPerDeg + 1e-9);
     ASSERT_GT(p.rssi, 0);
     ASSERT_GE(p.time_s, s.start_time_s - 0.05);
   }
@@ -177,7 +177,7 @@ TEST(Sweep, AHostTooSlowForTheScanRateLosesScansNotTheEndOfTheSweep) {
         // span part of a step about its middle beam).
         EXPECT_GT(b, *lo - 0.5 * step);
         EXPECT_LT(b, *hi + 0.5 * step);
-        if (b < (s.beta_start_deg + 2) * kDeg || b > (s.beta_end_deg - 2) * kDeg) continue;
+        if (b < (s.beta_start_deg + 2) * kRadPerDeg || b > (s.beta_end_deg - 2) * kRadPerDeg) continue;
         ++at_speed;
         double nearest = 1e9;
         for (const double pb : s.cloud.beta_rad) nearest = std::min(nearest, std::abs(pb - b));
@@ -213,7 +213,7 @@ TEST(Sweep, ScanLinesArriveWhileTheTurntableMoves) {
   EXPECT_GT(std::chrono::duration<double>(last - first).count(), 0.5);
   // On the wall, up to holding β for a whole line: 40 °/s for 20 ms (0.8°) at up to 3.5 m, plus 4σ of noise.
   const Vec3 n = u.pose.linear() * Vec3::UnitY(), on_wall = u.pose * Vec3(0, 3, 0);
-  const double limit = 3.5 * 0.8 * kDeg + 4 * kSigmaCloth;
+  const double limit = 3.5 * 0.8 * kRadPerDeg + 4 * kSigmaCloth;
   size_t off = 0;
   for (const Vec3& p : seen) off += std::abs((p - on_wall).dot(n)) > limit;
   EXPECT_EQ(off, 0u) << "of " << seen.size() << " shown points";

@@ -6,7 +6,7 @@
 
 #include "acquisition/emulated_turntable.hpp"
 #include "acquisition/turntable.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 using namespace sailshape;
 

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "acquisition/unit_config.hpp"
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 
 using namespace sailshape;
 

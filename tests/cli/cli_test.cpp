@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/params_io.hpp"
+#include "analysis/pipeline/params_io.hpp"
 #include "tests/cli/run_sailshape.hpp"
 
 namespace {

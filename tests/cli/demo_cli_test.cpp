@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "tests/cli/run_sailshape.hpp"
-#include "analysis/sail_generator.hpp"
+#include "analysis/design/sail_generator.hpp"
 #include "database/schema.hpp"
 #include "database/sqlite.hpp"
 

@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "analysis/cloud_io.hpp"
-#include "analysis/registration.hpp"
-#include "analysis/rigid_transform.hpp"
-#include "analysis/tunnel_scene.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/registration/registration.hpp"
+#include "analysis/registration/rigid_transform.hpp"
+#include "tests/support/tunnel_scene.hpp"
 #include "tests/cli/run_sailshape.hpp"
 
 namespace {

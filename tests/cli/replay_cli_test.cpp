@@ -14,7 +14,7 @@
 #include "acquisition/scan_data.hpp"
 #include "acquisition/turntable_protocol.hpp"
 #include "acquisition/unit_config.hpp"
-#include "analysis/cloud_io.hpp"
+#include "analysis/io/cloud_io.hpp"
 #include "tests/cli/run_sailshape.hpp"
 
 namespace {

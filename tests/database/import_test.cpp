@@ -7,7 +7,7 @@
 #include <cstring>
 #include <random>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/cloud_blob.hpp"
 #include "database/import.hpp"
 #include "database/schema.hpp"

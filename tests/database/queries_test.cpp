@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"
 #include "database/schema.hpp"

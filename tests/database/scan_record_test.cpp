@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/catalog.hpp"
 #include "database/import.hpp"
 #include "database/scan_record.hpp"

@@ -15,8 +15,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "analysis/errors.hpp"
-#include "analysis/sail_generator.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/design/sail_generator.hpp"
 #include "database/catalog.hpp"
 #include "database/import.hpp"
 #include "database/schema.hpp"

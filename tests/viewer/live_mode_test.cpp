@@ -10,10 +10,10 @@
 #include <thread>
 
 #include "acquisition/scene.hpp"
-#include "analysis/cloud_io.hpp"
-#include "analysis/errors.hpp"
-#include "analysis/sail_generator.hpp"
-#include "analysis/spars.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/design/sail_generator.hpp"
+#include "analysis/segmentation/spars.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/catalog_tree.hpp"
 #include "viewer/live_mode.hpp"

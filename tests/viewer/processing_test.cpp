@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "analysis/errors.hpp"
-#include "analysis/sail_generator.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/design/sail_generator.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/processing.hpp"
 #include "../analysis/footprint_scan.hpp"

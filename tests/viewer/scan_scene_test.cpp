@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
 #include "database/catalog.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/scan_scene.hpp"

@@ -10,9 +10,10 @@
 #include <fstream>
 
 #include "acquisition/scene.hpp"
-#include "analysis/design_compare.hpp"
-#include "analysis/errors.hpp"
-#include "analysis/sail_generator.hpp"
+#include "analysis/core/units.hpp"
+#include "analysis/design/design_compare.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/design/sail_generator.hpp"
 #include "database/scan_record.hpp"
 #include "database/schema.hpp"
 #include "viewer/catalog_tree.hpp"
@@ -23,7 +24,6 @@ namespace sailshape::viewer {
 namespace {
 
 constexpr double kSigmaCloth = 0.0041;  // SPEC §3, sail cloth
-constexpr double kDeg = M_PI / 180;
 
 Scene wallAt(double y) {
   Scene s;
@@ -199,7 +199,7 @@ TEST(ScannerSession, UnitFilesLoadIntoSlots) {
   const std::string path = dir.file("unit.json");
   UnitConfig u = compactUnit();
   u.name = "bow";
-  u.pose = makePose(Vec3(1, 2, 3), 0, 0, 90 * kDeg);
+  u.pose = makePose(Vec3(1, 2, 3), 0, 0, 90 * kRadPerDeg);
   std::ofstream(path) << unitToJson(u);
   ScannerSession session;
   session.addUnitFile(path);

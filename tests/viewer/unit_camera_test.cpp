@@ -3,14 +3,13 @@
 
 #include <cmath>
 
-#include "analysis/errors.hpp"
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "viewer/scanner_session.hpp"
 #include "viewer/unit_camera.hpp"
 
 namespace sailshape::viewer {
 namespace {
-
-constexpr double kDeg = M_PI / 180;
 
 void expectNear(const Vec3& a, const Vec3& b, double tol) {
   EXPECT_NEAR(a.x(), b.x(), tol);
@@ -21,8 +20,8 @@ void expectNear(const Vec3& a, const Vec3& b, double tol) {
 TEST(UnitCamera, TheDeckUnitLooksAftToPortAndUp) {
   // Shaft along boat +Z: unit Y is boat +Y (port), unit Z boat −X (aft); p = 0, so the eye is the pose's origin.
   const UnitConfig u = deckUnit(Vec3(1.5, -6.0, 1.2));
-  const double alpha = (u.output_start_deg + u.output_stop_deg) / 2 * kDeg;
-  const double beta = (u.start_angle_deg + u.sweep_angle_deg / 2) * kDeg;
+  const double alpha = (u.output_start_deg + u.output_stop_deg) / 2 * kRadPerDeg;
+  const double beta = (u.start_angle_deg + u.sweep_angle_deg / 2) * kRadPerDeg;
   const Vec3 dir(-std::sin(alpha) * std::sin(beta), std::sin(alpha) * std::cos(beta), std::cos(alpha));
   const CameraPlacement c = unitCamera(u, 10.0);
   expectNear(c.position, Vec3(1.5, -6.0, 1.2), 1e-9);
@@ -34,14 +33,14 @@ TEST(UnitCamera, TheDeckUnitLooksAftToPortAndUp) {
 
 TEST(UnitCamera, OffsetScannerAndYawedUnit) {
   UnitConfig u;
-  u.pose = makePose(Vec3(1, 2, 3), 0, 0, 90 * kDeg);  // unit X → boat +Y, unit Y → boat −X
+  u.pose = makePose(Vec3(1, 2, 3), 0, 0, 90 * kRadPerDeg);  // unit X → boat +Y, unit Y → boat −X
   u.p_m = 0.1;
-  u.theta_rad = 8 * kDeg;
+  u.theta_rad = 8 * kRadPerDeg;
   u.start_angle_deg = 10;
   u.sweep_angle_deg = 40;  // centre β = 30°
   u.output_start_deg = 0;
   u.output_stop_deg = 180;  // centre α = 90°: the beam at right angles to the shaft
-  const double b = 30 * kDeg, bt = 38 * kDeg;
+  const double b = 30 * kRadPerDeg, bt = 38 * kRadPerDeg;
   // Unit frame: origin (0, p cos(β+θ), p sin(β+θ)), beam (0, cos β, sin β); rotated by Rz(90°): (x, y, z) → (−y, x, z).
   const Vec3 eye(1 - 0.1 * std::cos(bt), 2, 3 + 0.1 * std::sin(bt));
   const Vec3 dir(-std::cos(b), 0, std::sin(b));
@@ -53,7 +52,7 @@ TEST(UnitCamera, OffsetScannerAndYawedUnit) {
 
 TEST(UnitCamera, LookingAlongTheShaftStillHasAnUp) {
   UnitConfig u;
-  u.pose = makePose(Vec3::Zero(), 0, -90 * kDeg, 0);  // shaft up
+  u.pose = makePose(Vec3::Zero(), 0, -90 * kRadPerDeg, 0);  // shaft up
   u.output_start_deg = -5;
   u.output_stop_deg = 5;  // centre α = 0: along the shaft, straight up
   u.start_angle_deg = 0;

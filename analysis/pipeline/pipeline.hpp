@@ -1,0 +1,118 @@
+#pragma once
+// The whole analysis of one flying-sail cloud (SPEC §4 steps 3–6):
+// normals → segmentation → cleaning → smoothing → surface → outline → sections.
+#include <string>
+#include <vector>
+
+#include "analysis/segmentation/cleaning.hpp"
+#include "analysis/core/cloud.hpp"
+#include "analysis/sections/luff_curve.hpp"
+#include "analysis/core/mesh.hpp"
+#include "analysis/segmentation/mixed_pixels.hpp"
+#include "analysis/spatial/normals.hpp"
+#include "analysis/core/progress.hpp"
+#include "analysis/outline/sail_outline.hpp"
+#include "analysis/sections/sections.hpp"
+#include "analysis/segmentation/segmentation.hpp"
+#include "analysis/surface/smoothing.hpp"
+#include "analysis/segmentation/spars.hpp"
+#include "analysis/surface/surface.hpp"
+
+namespace sailshape {
+
+struct AnalysisParams {
+  double sensor_sigma_m = 0.004;   // SPEC §3; feeds smoothing classes and uncertainties
+  // A scan that carries its samples' scan angles and the scanner's position loses
+  // its mixed pixels first (analysis/mixed_pixels.hpp). Its sensor_sigma_m follows
+  // the one above.
+  bool mixed_pixels = true;
+  MixedPixelParams mixed;
+  NormalParams normals;
+  bool segment = true;             // false: the cloud is the sail alone, skip segmentation
+  // Segmentation runs on a voxel-grid sample this many sensor σ wide when the
+  // scan is denser (0: full resolution), so normals and curvature see the same
+  // neighbourhood size relative to the noise whatever the scanner's density.
+  double segmentation_voxel_sigmas = 5.0;
+  // The working resolution (0: off, every sample goes on). With working_voxel_sigmas > 0, after
+  // segmentation a scan with three samples or more per column on average goes on as one
+  // point per occupied column, the mean of its samples (and of their attributes). The
+  // columns stand square on the sail's best-fit plane, working_voxel_sigmas sensor σ
+  // wide but never wider than working_voxel_of_extent times the sail's bounding-box
+  // diagonal, so a model-scale sail keeps its detail (the accuracy targets are met on
+  // 40,000-point scans of a 10 m sail, 2.2 cm or 1/480 of its 10.6 m diagonal apart).
+  // A column whose samples lie more than working_column_depth_sigmas σ apart along the
+  // plane's normal (the surface steeper than about 45° to the plane there, or two
+  // sheets over one another) keeps every sample. The corners still read the scan's own
+  // outermost samples. At 5 (2 cm, the default) a 200,000-point scan of a 10 m main is
+  // analysed 3.4 times as fast, and closer to the truth: the mean of the samples in a
+  // column is as good a point as a smoothing over them (bench/README.md, 2026-12-02).
+  // (Cube voxels, before then, cut a noisy surface's samples apart by their noise where
+  // a voxel face ran along it; their means lay about ±0.8σ off the surface, and entry
+  // angles on dense scans came out up to 3° off.)
+  double working_voxel_sigmas = 5;
+  double working_column_depth_sigmas = 12;
+  double working_voxel_of_extent = 1.0 / 500;
+  RegionGrowingParams region_growing;
+  SailPickParams sail_pick;
+  // Round spars (mast, boom) found beside the picked sail: points on them leave the
+  // sail, and the sail's edge strip whose neighbourhoods mixed in spar points comes
+  // back where it lies on the sail's surface. Its sensor_sigma_m follows the one above.
+  bool find_spars = true;
+  SparSearchParams spars;
+  bool statistical_outliers = true;
+  StatisticalOutlierParams statistical;
+  bool radius_outliers = true;
+  RadiusOutlierParams radius;
+  bool readmit_surface_points = true;  // give back removed points that lie on the surface
+  ReadmitParams readmit;
+  bool smooth = true;
+  SmoothingParams smoothing;
+  SurfaceParams surface;
+  OutlineParams outline;
+  SectionParams sections;
+};
+
+struct StageReport {
+  std::string name;
+  size_t points_in = 0, points_out = 0;
+  double seconds = 0;
+  std::vector<std::string> warnings;
+};
+
+struct SailAnalysis {
+  size_t points_in = 0;
+  size_t sail_points = 0;            // scan points on the sail after segmentation and cleaning
+  size_t working_points = 0;         // the points the stages after segmentation worked on
+  double working_voxel_m = 0;        // their columns' width (0: the scan's own points)
+  Cloud sail_cloud;                  // the smoothed sail points
+  Mesh mesh;
+  SailOutline outline;
+  SectionAnalysis sections;
+  LuffCurve luff;
+  Smoothing smoothing_stats;         // displacement classes (cloud emptied to save memory)
+  std::vector<ClusterInfo> clusters; // what segmentation found
+  std::vector<SparFit> spars;        // round spars found beside the sail
+  std::vector<StageReport> stages;
+  std::vector<std::string> warnings; // every stage's warnings, prefixed by stage
+};
+
+// p.mixed with p's sensor σ.
+MixedPixelParams mixedPixelParams(const AnalysisParams& p);
+// The scan less its mixed pixels (when it carries scan angles and a viewpoint and
+// p.mixed_pixels is set), for a crop to the sail before analyzeSail: they are
+// told by the surfaces on both sides of them, which the crop would cut off.
+Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p);
+
+// A corner whose samples' scan line has lost lines beside it (Cloud::lost_beta_rad:
+// the sweep never received them) may lie a line spacing further out than the samples
+// place it for each lost in a row; that, |corner − viewpoint| times the turntable's
+// step between lines, joins the corner's σ. Needs the scan's angles and viewpoint;
+// `scan` is the cloud the outline was found on, in its frame. Lost lines must be
+// ascending, as sweeps write them. Returns a warning per corner widened.
+std::vector<std::string> widenCornersBesideLostLines(SailOutline& outline, const Cloud& scan);
+
+// Throws InvalidInput for an empty cloud or bad parameters, AnalysisError when
+// a stage cannot produce its result (no sail found, no boundary, ...).
+SailAnalysis analyzeSail(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {});
+
+}  // namespace sailshape

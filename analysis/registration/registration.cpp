@@ -1,0 +1,468 @@
+#include "analysis/registration/registration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
+#include "analysis/spatial/neighbours.hpp"
+#include "analysis/spatial/normals.hpp"
+
+namespace sailshape {
+namespace {
+
+std::string vecText(const Vec3& v) { return "(" + formatFixed(v.x()) + ", " + formatFixed(v.y()) + ", " + formatFixed(v.z()) + ")"; }
+
+std::string describePlanes(const std::vector<DetectedPlane>& planes) {
+  if (planes.empty()) return "none";
+  std::string s;
+  for (size_t i = 0; i < planes.size(); ++i) {
+    if (i) s += "; ";
+    s += "normal " + vecText(planes[i].normal) + " with " + std::to_string(planes[i].points) + " points";
+  }
+  return s;
+}
+
+double angleDeg(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) / kRadPerDeg; }
+
+// Angle between the lines of two normals, in [0°, 90°].
+double lineAngleDeg(const Vec3& a, const Vec3& b) { return std::acos(std::min(1.0, std::abs(a.dot(b)))) / kRadPerDeg; }
+
+double det3(const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); }
+
+// At most `limit` of `indices`, evenly spread.
+std::vector<uint32_t> thin(const std::vector<uint32_t>& indices, size_t limit) {
+  if (indices.size() <= limit) return indices;
+  std::vector<uint32_t> out;
+  out.reserve(limit);
+  const double step = static_cast<double>(indices.size()) / static_cast<double>(limit);
+  for (size_t i = 0; i < limit; ++i) out.push_back(indices[static_cast<size_t>(static_cast<double>(i) * step)]);
+  return out;
+}
+
+std::vector<uint32_t> allIndices(size_t n) {
+  std::vector<uint32_t> v(n);
+  for (size_t i = 0; i < n; ++i) v[i] = static_cast<uint32_t>(i);
+  return v;
+}
+
+void checkParams(const Cloud& reference, const Cloud& moving, const RegistrationParams& p) {
+  auto bad = [](const std::string& what) { throw InvalidInput("[registerClouds] " + what); };
+  if (p.method != "planes" && p.method != "svd" && p.method != "icp")
+    bad("method must be planes, svd or icp (got '" + p.method + "')");
+  if (p.method == "svd" && p.pairs.size() < 3)
+    bad("the svd method needs at least 3 point pairs (got " + std::to_string(p.pairs.size()) + ")");
+  if (p.method == "planes" && p.pairs.size() > 1)
+    bad("the planes method takes at most one point pair, for the translation (got " + std::to_string(p.pairs.size()) +
+        ")");
+  if (p.method == "planes" && !p.plane_hints.empty() && p.plane_hints.size() != (p.pairs.size() == 1 ? 2u : 3u))
+    bad("plane hints must name " + std::string(p.pairs.size() == 1 ? "2 planes (a pair gives the translation)" : "3 planes") +
+        " (got " + std::to_string(p.plane_hints.size()) + ")");
+  if (!(p.crossed_radius_m > 0)) bad("crossed_radius_m must be > 0 (got " + std::to_string(p.crossed_radius_m) + ")");
+  if (!(p.uncertainty_m > 0)) bad("uncertainty_m must be > 0 (got " + std::to_string(p.uncertainty_m) + ")");
+  if (!(p.icp_initial_correspondence_m > 0))
+    bad("icp_initial_correspondence_m must be > 0 (got " + std::to_string(p.icp_initial_correspondence_m) + ")");
+  if (p.max_icp_points < 100) bad("max_icp_points must be >= 100 (got " + std::to_string(p.max_icp_points) + ")");
+  if (p.match.verify_samples < 10) bad("match.verify_samples must be >= 10");
+  if (!(p.match.verify_radius_m > 0)) bad("match.verify_radius_m must be > 0");
+  if (!(p.match.max_angle_mismatch_deg > 0)) bad("match.max_angle_mismatch_deg must be > 0");
+  if (!(p.match.min_plane_angle_deg > 0 && p.match.min_plane_angle_deg <= 90))
+    bad("match.min_plane_angle_deg must be in (0, 90] (got " + std::to_string(p.match.min_plane_angle_deg) + ")");
+  if (reference.empty() || moving.empty())
+    bad("both clouds need points (reference " + std::to_string(reference.size()) + ", moving " +
+        std::to_string(moving.size()) + ")");
+}
+
+// The plane whose inliers come closest to `point`.
+size_t planeNearest(const Cloud& cloud, const std::vector<DetectedPlane>& planes, const Vec3& point,
+                    const char* which) {
+  size_t best = planes.size();
+  double best_d2 = 1e300;
+  for (size_t i = 0; i < planes.size(); ++i)
+    for (uint32_t j : planes[i].indices) {
+      const double d2 = (cloud.points[j] - point).squaredNorm();
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best = i;
+      }
+    }
+  if (best == planes.size() || best_d2 > 0.25 * 0.25)
+    throw AnalysisError(std::string("[registerClouds] no plane of the ") + which + " cloud lies near the hint " +
+                        vecText(point) + " (nearest plane point " + formatFixed(std::sqrt(best_d2)) + " m away)");
+  return best;
+}
+
+struct Candidate {
+  RigidTransform transform;
+  size_t ref[3], mov[3];
+  size_t score = 0;      // sampled moving points near the reference
+  size_t planes_on = 0;  // moving planes lying on a matching reference plane
+};
+
+// The study's coarse alignment from matched planes, chosen among every
+// consistent match by how many moving points it brings near the reference.
+RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
+                              const Progress& progress, Registration& out, std::vector<PlaneAnchor>& anchors) {
+  const PlaneDetection dr = detectPlanes(reference, p.planes, progress);
+  const PlaneDetection dm = detectPlanes(moving, p.planes, progress);
+  for (const auto& w : dr.warnings) out.warnings.push_back("reference planes: " + w);
+  for (const auto& w : dm.warnings) out.warnings.push_back("moving planes: " + w);
+  out.reference_planes = dr.planes.size();
+  out.moving_planes = dm.planes.size();
+  const bool pair_translation = p.pairs.size() == 1;
+  const size_t need = pair_translation ? 2 : 3;
+  const std::string need_text = pair_translation ? "two non-parallel planes (with the picked pair)"
+                                                 : "three planes whose normals are independent";
+  for (const auto* d : {&dr, &dm}) {
+    const char* which = d == &dr ? "reference" : "moving";
+    if (d->planes.size() < need)
+      throw AnalysisError(std::string("[registerClouds] fewer than ") + (need == 3 ? "three" : "two") +
+                          " usable planes in the " + which + " cloud (found " + std::to_string(d->planes.size()) +
+                          ": " + describePlanes(d->planes) + "); the plane method needs " + need_text +
+                          " — scan more of the walls/deck, add a reference object, or use --method svd");
+  }
+  const PlaneMatchParams& m = p.match;
+  auto usablePair = [&](const Vec3& a, const Vec3& b) { return lineAngleDeg(a, b) >= m.min_plane_angle_deg; };
+  auto usableTriple = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+    return usablePair(a, b) && usablePair(a, c) && usablePair(b, c) && std::abs(det3(a, b, c)) >= m.min_triple_det;
+  };
+  // Reference combinations: hints, or every usable pair/triple (largest planes first).
+  std::vector<std::vector<size_t>> ref_sets, mov_sets_hinted;
+  const auto& R = dr.planes;
+  const auto& M = dm.planes;
+  if (!p.plane_hints.empty()) {
+    std::vector<size_t> rs, ms;
+    for (const PointPair& h : p.plane_hints) {
+      rs.push_back(planeNearest(reference, R, h.reference, "reference"));
+      ms.push_back(planeNearest(moving, M, h.moving, "moving"));
+    }
+    ref_sets.push_back(rs);
+    mov_sets_hinted.push_back(ms);
+  } else {
+    for (size_t i = 0; i < R.size(); ++i)
+      for (size_t j = i + 1; j < R.size(); ++j) {
+        if (!usablePair(R[i].normal, R[j].normal)) continue;
+        if (need == 2) {
+          ref_sets.push_back({i, j});
+          continue;
+        }
+        for (size_t l = j + 1; l < R.size(); ++l)
+          if (usableTriple(R[i].normal, R[j].normal, R[l].normal)) ref_sets.push_back({i, j, l});
+      }
+  }
+  auto independent = [&](const std::vector<DetectedPlane>& planes, const std::vector<size_t>& s) {
+    return s.size() == 2 ? usablePair(planes[s[0]].normal, planes[s[1]].normal)
+                         : usableTriple(planes[s[0]].normal, planes[s[1]].normal, planes[s[2]].normal);
+  };
+  if (ref_sets.empty() || (!p.plane_hints.empty() && !independent(R, ref_sets[0])))
+    throw AnalysisError("[registerClouds] the reference cloud's planes are parallel or their normals share one "
+                        "plane (found " + describePlanes(R) + "): the plane method needs " + need_text + " at least " +
+                        formatFixed(m.min_plane_angle_deg, 0) +
+                        "° apart; parallel planes leave the rotation about their normal and the translation along "
+                        "them undetermined");
+  if (!p.plane_hints.empty() && !independent(M, mov_sets_hinted[0]))
+    throw AnalysisError("[registerClouds] the hinted planes of the moving cloud are parallel or their normals share "
+                        "one plane: the plane method needs " + need_text);
+
+  const KdTree ref_tree(reference.points);
+  const std::vector<uint32_t> samples = thin(allIndices(moving.size()), m.verify_samples);
+  const double r2 = m.verify_radius_m * m.verify_radius_m;
+  // Which reference plane each reference point belongs to (R.size(): none).
+  std::vector<uint32_t> ref_label(reference.size(), static_cast<uint32_t>(R.size()));
+  for (size_t j = 0; j < R.size(); ++j)
+    for (uint32_t i : R[j].indices) ref_label[i] = static_cast<uint32_t>(j);
+  std::vector<std::vector<uint32_t>> plane_samples;
+  for (const DetectedPlane& pl : M) plane_samples.push_back(thin(pl.indices, 100));
+  // A candidate scores first by how many moving planes land on a reference
+  // plane of the same orientation with overlapping points (a symmetric chamber
+  // maps walls onto walls either way; the cube and other small planes decide),
+  // then by how many sampled moving points come near the reference.
+  // The reference plane each moving plane lands on under t (R.size(): none).
+  auto landings = [&](const RigidTransform& t) {
+    std::vector<size_t> on(M.size(), R.size());
+    std::vector<uint32_t> idx;
+    std::vector<double> d2;
+    for (size_t k = 0; k < M.size(); ++k) {
+      const Vec3 n = t.linear() * M[k].normal;
+      std::vector<size_t> hits(R.size(), 0);
+      for (uint32_t i : plane_samples[k]) {
+        ref_tree.nearest(t * moving.points[i], 1, idx, d2);
+        if (d2.empty() || d2[0] > r2 || ref_label[idx[0]] == R.size()) continue;
+        if (angleDeg(n, R[ref_label[idx[0]]].normal) <= 2 * m.max_angle_mismatch_deg) ++hits[ref_label[idx[0]]];
+      }
+      const size_t j = static_cast<size_t>(std::max_element(hits.begin(), hits.end()) - hits.begin());
+      if (10 * hits[j] >= plane_samples[k].size() && hits[j] > 0) on[k] = j;
+    }
+    return on;
+  };
+  size_t best_planes_on = 0;
+  auto score = [&](const RigidTransform& t, size_t& planes_on) {
+    std::vector<uint32_t> idx;
+    std::vector<double> d2;
+    planes_on = 0;
+    for (size_t j : landings(t)) planes_on += j < R.size();
+    // Only a candidate that lands as many planes as the best so far can win or
+    // tie; the others need no point count.
+    if (planes_on < best_planes_on) return size_t{0};
+    best_planes_on = planes_on;
+    size_t count = 0;
+    for (uint32_t i : samples) {
+      ref_tree.nearest(t * moving.points[i], 1, idx, d2);
+      count += !d2.empty() && d2[0] <= r2;
+    }
+    return count;
+  };
+  auto sameTransform = [](const RigidTransform& a, const RigidTransform& b) {
+    return rotationDifferenceDeg(a.linear(), b.linear()) < 1.0 && (a.translation() - b.translation()).norm() < 0.05;
+  };
+
+  std::vector<Candidate> candidates;
+  bool any_moving_set = false;
+  const double tol = m.max_angle_mismatch_deg;
+  for (size_t s = 0; s < ref_sets.size(); ++s) {
+    progress("plane matching", static_cast<double>(s) / static_cast<double>(ref_sets.size()));
+    const std::vector<size_t>& rs = ref_sets[s];
+    std::vector<std::vector<size_t>> mov_sets;
+    if (!p.plane_hints.empty()) {
+      mov_sets = mov_sets_hinted;
+    } else {
+      for (size_t a = 0; a < M.size(); ++a)
+        for (size_t b = 0; b < M.size(); ++b) {
+          if (b == a) continue;
+          if (need == 2) {
+            mov_sets.push_back({a, b});
+            continue;
+          }
+          for (size_t c = 0; c < M.size(); ++c)
+            if (c != a && c != b) mov_sets.push_back({a, b, c});
+        }
+    }
+    for (const std::vector<size_t>& ms : mov_sets) {
+      // The angles between normals are the same in every frame; so is the handedness.
+      bool ok = true;
+      for (size_t x = 0; x < rs.size() && ok; ++x)
+        for (size_t y = x + 1; y < rs.size() && ok; ++y)
+          ok = std::abs(angleDeg(R[rs[x]].normal, R[rs[y]].normal) - angleDeg(M[ms[x]].normal, M[ms[y]].normal)) <= tol;
+      if (!ok || !independent(M, ms)) continue;
+      if (need == 3 && (det3(R[rs[0]].normal, R[rs[1]].normal, R[rs[2]].normal) > 0) !=
+                           (det3(M[ms[0]].normal, M[ms[1]].normal, M[ms[2]].normal) > 0))
+        continue;
+      any_moving_set = true;
+      Candidate c;
+      const Eigen::Matrix3d rot =
+          rotationFromNormalPairs(R[rs[0]].normal, R[rs[1]].normal, M[ms[0]].normal, M[ms[1]].normal);
+      if (need == 3 && angleDeg(rot * M[ms[2]].normal, R[rs[2]].normal) > tol) continue;
+      c.transform = RigidTransform::Identity();
+      c.transform.linear() = rot;
+      if (pair_translation) {
+        c.transform.translation() = p.pairs[0].reference - rot * p.pairs[0].moving;
+      } else {
+        c.transform.translation() = intersectPlanes(R[rs[0]], R[rs[1]], R[rs[2]], 0.0) -
+                                    rot * intersectPlanes(M[ms[0]], M[ms[1]], M[ms[2]], 0.0);
+      }
+      for (size_t x = 0; x < 3; ++x) {
+        c.ref[x] = x < rs.size() ? rs[x] : rs[0];
+        c.mov[x] = x < ms.size() ? ms[x] : ms[0];
+      }
+      bool seen = false;
+      for (const Candidate& other : candidates) seen = seen || sameTransform(other.transform, c.transform);
+      if (seen) continue;
+      c.score = score(c.transform, c.planes_on);
+      candidates.push_back(c);
+    }
+  }
+  progress("plane matching", 1.0);
+  if (candidates.empty())
+    throw AnalysisError(std::string("[registerClouds] no ") + (need == 3 ? "three" : "two") +
+                        " planes of the moving cloud match the angles between the reference planes within " +
+                        formatFixed(tol, 1) + "° (" + (any_moving_set ? "the third normal disagreed" : "no consistent set") +
+                        "; reference: " + describePlanes(R) + "; moving: " + describePlanes(M) +
+                        ") — give plane hints or picked pairs");
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return a.planes_on != b.planes_on ? a.planes_on > b.planes_on : a.score > b.score;
+  });
+  const Candidate& best = candidates.front();
+  out.candidates = candidates.size();
+  out.coarse_overlap_fraction = static_cast<double>(best.score) / static_cast<double>(samples.size());
+  out.coarse_planes_on = best.planes_on;
+  for (size_t x = 0; x < need; ++x) {
+    PlanePairing pp;
+    pp.reference_plane = best.ref[x];
+    pp.moving_plane = best.mov[x];
+    pp.reference_normal = R[best.ref[x]].normal;
+    pp.moving_normal = M[best.mov[x]].normal;
+    pp.reference_points = R[best.ref[x]].points;
+    pp.moving_points = M[best.mov[x]].points;
+    out.pairings.push_back(pp);
+  }
+  for (size_t i = 1; i < candidates.size(); ++i) {
+    if (candidates[i].planes_on < best.planes_on ||
+        static_cast<double>(candidates[i].score) < m.ambiguity_ratio * static_cast<double>(best.score))
+      break;
+    out.ambiguous = true;
+    out.warnings.push_back("ambiguous plane match: another alignment " +
+                           formatFixed(rotationDifferenceDeg(best.transform.linear(), candidates[i].transform.linear()), 1) +
+                           "° and " + formatFixed((best.transform.translation() - candidates[i].transform.translation()).norm()) +
+                           " m away puts as many planes (" + std::to_string(best.planes_on) + ") and " +
+                           std::to_string(candidates[i].score) + " sampled points (best " + std::to_string(best.score) +
+                           ") on the reference; give plane hints or a picked pair");
+    break;
+  }
+  // Every moving plane that lands on a reference plane anchors the refinement.
+  const std::vector<size_t> on = landings(best.transform);
+  for (size_t k = 0; k < M.size(); ++k) {
+    if (on[k] == R.size()) continue;
+    PlaneAnchor a;
+    a.normal = R[on[k]].normal;
+    a.offset_m = R[on[k]].offset_m;
+    for (uint32_t i : thin(M[k].indices, p.max_anchor_points)) a.moving_points.push_back(moving.points[i]);
+    anchors.push_back(std::move(a));
+  }
+  return best.transform;
+}
+
+// How well the aligned moving cloud lies on the reference surface over their
+// overlap (crossed filter at radius_m): distance of each overlapping moving
+// point to the tangent plane of its nearest reference point.
+struct SurfaceFit {
+  double rms_m = 0;
+  double inlier_fraction = 0;  // of those distances within `inlier_m`
+  size_t points = 0;
+};
+SurfaceFit surfaceFit(const Cloud& reference, const Cloud& aligned, double radius_m, double inlier_m, int k,
+                      size_t max_points) {
+  SurfaceFit fit;
+  const CrossedFilter cf = crossedFilter(reference, aligned, radius_m);
+  if (cf.reference.size() < static_cast<size_t>(k) || cf.moving.empty()) return fit;
+  const Cloud ref = selectPoints(reference, cf.reference);
+  NormalParams np;
+  np.k_neighbours = k;
+  np.orientation = "none";
+  np.robust = false;
+  const Normals n = estimateNormals(ref, np).normals;
+  const KdTree tree(ref.points);
+  double sum2 = 0;
+  size_t inliers = 0;
+  std::vector<uint32_t> idx;
+  std::vector<double> d2;
+  for (uint32_t i : thin(cf.moving, max_points)) {
+    const Vec3& q = aligned.points[i];
+    tree.nearest(q, 1, idx, d2);
+    const double r = n.normals[idx[0]].dot(q - ref.points[idx[0]]);
+    sum2 += r * r;
+    inliers += std::abs(r) <= inlier_m;
+    ++fit.points;
+  }
+  fit.rms_m = std::sqrt(sum2 / static_cast<double>(fit.points));
+  fit.inlier_fraction = static_cast<double>(inliers) / static_cast<double>(fit.points);
+  return fit;
+}
+
+}  // namespace
+
+RigidTransform transformFromPlanes(const DetectedPlane (&reference)[3], const DetectedPlane (&moving)[3]) {
+  const Eigen::Matrix3d rot =
+      rotationFromNormalPairs(reference[0].normal, reference[1].normal, moving[0].normal, moving[1].normal);
+  const Vec3 xr = intersectPlanes(reference[0], reference[1], reference[2]);
+  const Vec3 xm = intersectPlanes(moving[0], moving[1], moving[2]);
+  RigidTransform t = RigidTransform::Identity();
+  t.linear() = rot;
+  t.translation() = xr - rot * xm;
+  return t;
+}
+
+Registration registerClouds(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
+                            const Progress& progress) {
+  checkParams(reference, moving, p);
+  Registration out;
+  out.method = p.method;
+  RigidTransform coarse = RigidTransform::Identity();
+  std::vector<PlaneAnchor> anchors;
+  if (p.method == "planes") {
+    coarse = planeAlignment(reference, moving, p, progress, out, anchors);
+  } else if (p.method == "svd") {
+    const KabschFit fit = fitKabsch(p.pairs);
+    coarse = fit.transform;
+    if (fit.reflection_corrected)
+      out.warnings.push_back("the picked pairs fit a reflection best; the nearest rotation was used — check the pairs");
+    if (fit.rms_m > p.uncertainty_m)
+      out.warnings.push_back("picked pairs disagree by " + formatFixed(fit.rms_m * 1000, 1) + " mm RMS, above the " +
+                             formatFixed(p.uncertainty_m * 1000, 1) + " mm uncertainty (picking error)");
+  } else {
+    // Plain ICP from the raw pose: wide correspondences over both whole clouds.
+    IcpParams ip = p.icp;
+    ip.method = "point-to-point";
+    ip.max_correspondence_m = p.icp_initial_correspondence_m;
+    const Cloud ref_sub = selectPoints(reference, thin(allIndices(reference.size()), p.max_icp_points));
+    const Cloud mov_sub = selectPoints(moving, thin(allIndices(moving.size()), p.max_icp_points));
+    const IcpResult icp = refineIcp(ref_sub, mov_sub, p.initial, ip, progress);
+    for (const auto& w : icp.warnings) out.warnings.push_back("plain ICP: " + w);
+    coarse = icp.transform;
+  }
+  out.coarse = coarse;
+
+  // Crossed filter: only the overlap can hold right correspondences.
+  const CrossedFilter overlap = crossedFilter(reference, transformCloud(moving, coarse), p.crossed_radius_m);
+  out.overlap_reference_points = overlap.reference.size();
+  out.overlap_moving_points = overlap.moving.size();
+  if (overlap.moving.size() < p.min_overlap_points || overlap.reference.size() < p.min_overlap_points)
+    throw AnalysisError("[registerClouds] no overlap: after the " + p.method + " alignment only " +
+                        std::to_string(overlap.moving.size()) + " moving and " +
+                        std::to_string(overlap.reference.size()) + " reference points have a point of the other cloud within " +
+                        formatFixed(p.crossed_radius_m) + " m (need " + std::to_string(p.min_overlap_points) +
+                        "); the clouds must see some of the same surfaces");
+  const Cloud mov_overlap = selectPoints(moving, overlap.moving);
+  out.before_refinement = nearestDistanceStats(reference, transformCloud(mov_overlap, coarse));
+
+  const Cloud ref_sub = selectPoints(reference, thin(overlap.reference, p.max_icp_points));
+  const Cloud mov_sub = selectPoints(moving, thin(overlap.moving, p.max_icp_points));
+  RigidTransform final_t = coarse;
+  out.converged = true;
+  if (p.refine) {
+    IcpParams ip = p.icp;
+    ip.max_correspondence_m = std::min(ip.max_correspondence_m, p.crossed_radius_m);
+    const IcpResult icp =
+        refineIcp(ref_sub, mov_sub, coarse, ip, progress, ip.method == "point-to-plane" ? anchors : std::vector<PlaneAnchor>{});
+    for (const auto& w : icp.warnings) out.warnings.push_back("refinement: " + w);
+    out.icp_iterations = icp.iterations;
+    out.converged = icp.converged;
+    final_t = icp.transform;
+  }
+  out.transform = final_t;
+  out.rotation = final_t.linear();
+  out.translation = final_t.translation();
+  out.after_refinement = nearestDistanceStats(reference, transformCloud(mov_overlap, final_t));
+  const SurfaceFit fit = surfaceFit(reference, transformCloud(moving, final_t), p.crossed_radius_m, p.uncertainty_m,
+                                    p.icp.normal_k, p.max_icp_points);
+  out.fitness_rms_m = fit.rms_m;
+  out.inlier_fraction = fit.inlier_fraction;
+  out.below_uncertainty = fit.points > 0 && out.fitness_rms_m <= p.uncertainty_m;
+  for (PlanePairing& pp : out.pairings) pp.angle_after_deg = angleDeg(out.rotation * pp.moving_normal, pp.reference_normal);
+  if (!out.below_uncertainty)
+    out.warnings.push_back("fitness " + formatFixed(out.fitness_rms_m * 1000, 1) + " mm RMS is above the sensor uncertainty (" +
+                           formatFixed(p.uncertainty_m * 1000, 1) + " mm): the registration is not good enough");
+  if (out.inlier_fraction < p.min_inlier_fraction)
+    out.warnings.push_back("only " + formatFixed(100 * out.inlier_fraction, 1) + " % of the overlapping points lie within " +
+                           formatFixed(p.uncertainty_m * 1000, 1) + " mm of the reference surface (need " +
+                           formatFixed(100 * p.min_inlier_fraction, 0) + " %): surfaces cross rather than coincide");
+  out.accepted = out.below_uncertainty && out.inlier_fraction >= p.min_inlier_fraction && out.converged && !out.ambiguous;
+  return out;
+}
+
+Drift compareTransforms(const RigidTransform& stored, const RigidTransform& fresh, double radius_m,
+                        double max_displacement_m) {
+  if (!(radius_m >= 0) || !(max_displacement_m > 0))
+    throw InvalidInput("[compareTransforms] radius_m must be >= 0 and max_displacement_m > 0 (got " +
+                       std::to_string(radius_m) + ", " + std::to_string(max_displacement_m) + ")");
+  Drift d;
+  d.rotation_deg = rotationDifferenceDeg(stored.linear(), fresh.linear());
+  d.translation_m = (fresh.translation() - stored.translation()).norm();
+  // |ΔR·x + Δt| ≤ |Δt| + 2 sin(θ/2)·|x| for every x within the radius.
+  d.max_displacement_m = d.translation_m + 2 * std::sin(d.rotation_deg * kRadPerDeg / 2) * radius_m;
+  d.moved = d.max_displacement_m > max_displacement_m;
+  return d;
+}
+
+}  // namespace sailshape

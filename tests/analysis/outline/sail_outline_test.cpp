@@ -1,0 +1,338 @@
+// The outline on meshes whose boundary is known by construction: a regularly
+// triangulated rectangle (a square-top sail's shape) in the vertical x-z plane.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+
+#include "analysis/core/errors.hpp"
+#include "analysis/design/sail_generator.hpp"
+#include "analysis/outline/sail_outline.hpp"
+#include "analysis/surface/surface.hpp"
+#include "tests/support/fixtures.hpp"
+
+namespace sailshape {
+namespace {
+
+constexpr double kSpacing = 0.05;        // m between grid vertices
+constexpr int kCellsX = 40, kCellsZ = 80;  // 2 m wide (x), 4 m high (z)
+
+// Vertex (i, j) at x = i·spacing, z = j·spacing; two triangles per cell except
+// the cells in `hole` (a rectangle of cells, empty when lo > hi).
+Mesh rectangle(int hole_lo = 1, int hole_hi = 0) {
+  Mesh m;
+  for (int j = 0; j <= kCellsZ; ++j)
+    for (int i = 0; i <= kCellsX; ++i) m.vertices.emplace_back(i * kSpacing, 0.0, j * kSpacing);
+  auto v = [](int i, int j) { return static_cast<uint32_t>(j * (kCellsX + 1) + i); };
+  for (int j = 0; j < kCellsZ; ++j)
+    for (int i = 0; i < kCellsX; ++i) {
+      if (i >= hole_lo && i <= hole_hi && j >= hole_lo && j <= hole_hi) continue;
+      m.triangles.push_back({v(i, j), v(i + 1, j), v(i + 1, j + 1)});
+      m.triangles.push_back({v(i, j), v(i + 1, j + 1), v(i, j + 1)});
+    }
+  return m;
+}
+
+bool onRectangleEdge(const Vec3& p) {
+  const double w = kCellsX * kSpacing, h = kCellsZ * kSpacing, eps = 1e-9;
+  return std::abs(p.x()) < eps || std::abs(p.x() - w) < eps || std::abs(p.z()) < eps || std::abs(p.z() - h) < eps;
+}
+
+// Square top: tack forward (larger x) at the foot, head forward at the top. The
+// corners are sampled exactly; the fitted edges may move them by up to a spacing.
+void expectRectangleCorners(const SailOutline& o) {
+  ASSERT_TRUE(o.has_peak);
+  const double w = kCellsX * kSpacing, h = kCellsZ * kSpacing;
+  EXPECT_LT((o.tack - Vec3(w, 0, 0)).norm(), kSpacing);
+  EXPECT_LT((o.clew - Vec3(0, 0, 0)).norm(), kSpacing);
+  EXPECT_LT((o.head - Vec3(w, 0, h)).norm(), kSpacing);
+  EXPECT_LT((o.peak - Vec3(0, 0, h)).norm(), kSpacing);
+}
+
+TEST(SailOutline, BoundaryOfARectangleIsItsOuterLoopWithFourCorners) {
+  // A hole of 10 x 10 cells: a second boundary loop, shorter than the outer one.
+  const SailOutline o = extractOutline(rectangle(15, 24));
+  // Every grid vertex on the rectangle's edges, once: 2 (40 + 80) of them.
+  ASSERT_EQ(o.boundary.size(), static_cast<size_t>(2 * (kCellsX + kCellsZ)));
+  for (const Vec3& p : o.boundary) EXPECT_TRUE(onRectangleEdge(p)) << p.transpose();
+  EXPECT_NEAR(o.boundary_spacing_m, kSpacing, 1e-12);
+  expectRectangleCorners(o);
+  const double w = kCellsX * kSpacing, h = kCellsZ * kSpacing;
+  EXPECT_NEAR(o.luff_length_m, h, kSpacing);
+  EXPECT_NEAR(o.foot_length_m, w, kSpacing);
+}
+
+// A hole that touches an edge at one vertex, where two triangles meet only at
+// their tips: the hole's loop and the outer loop pass through that vertex. The
+// outline goes straight on along the edge there; taken round the hole, the
+// hole's far side reads as a sharp corner (a gennaker's clew was once found in
+// mid-luff that way). Once on the leech (x = 0), once on the luff (x = width):
+// a walk may leave the pinch either way.
+TEST(SailOutline, AHoleTouchingAnEdgeAtOneVertexStaysOutOfTheOutline) {
+  auto v = [](int i, int j) { return static_cast<uint32_t>(j * (kCellsX + 1) + i); };
+  constexpr int j0 = 40;  // the pinch's row, mid-height
+  for (const bool on_luff : {false, true}) {
+    SCOPED_TRACE(on_luff ? "pinch on the luff" : "pinch on the leech");
+    const int pinch_i = on_luff ? kCellsX : 0;
+    // The one triangle at the pinch that holds neither of its edge segments, and
+    // a block of 10 x 10 cells beside it.
+    const std::array<uint32_t, 3> tip_triangle =
+        on_luff ? std::array<uint32_t, 3>{v(kCellsX - 1, j0 - 1), v(kCellsX, j0), v(kCellsX - 1, j0)}
+                : std::array<uint32_t, 3>{v(0, j0), v(1, j0), v(1, j0 + 1)};
+    const int hole_i = on_luff ? kCellsX - 11 : 1, hole_j = on_luff ? j0 - 5 : j0;
+    Mesh m = rectangle();
+    std::vector<std::array<uint32_t, 3>> kept;
+    for (const auto& t : m.triangles) {
+      // Both triangles of cell (i, j) start at its vertex (i, j).
+      const int i = static_cast<int>(t[0] % (kCellsX + 1)), j = static_cast<int>(t[0] / (kCellsX + 1));
+      const bool in_hole = i >= hole_i && i < hole_i + 10 && j >= hole_j && j < hole_j + 10;
+      if (!in_hole && t != tip_triangle) kept.push_back(t);
+    }
+    m.triangles = kept;
+    // The fixture is what it claims: four boundary edges meet at the pinch.
+    std::map<std::pair<uint32_t, uint32_t>, int> uses;
+    for (const auto& t : m.triangles)
+      for (int e = 0; e < 3; ++e) ++uses[std::minmax(t[e], t[(e + 1) % 3])];
+    int at_pinch = 0;
+    for (const auto& [edge, n] : uses) at_pinch += n == 1 && (edge.first == v(pinch_i, j0) || edge.second == v(pinch_i, j0));
+    ASSERT_EQ(at_pinch, 4);
+
+    const SailOutline o = extractOutline(m);
+    ASSERT_EQ(o.boundary.size(), static_cast<size_t>(2 * (kCellsX + kCellsZ)));
+    for (const Vec3& p : o.boundary) EXPECT_TRUE(onRectangleEdge(p)) << p.transpose();
+    expectRectangleCorners(o);
+  }
+}
+
+TEST(SailOutline, ATriangleNamingAMissingVertexIsRejected) {
+  Mesh m = rectangle();
+  m.triangles.push_back({0, 1, 99999});
+  expectInvalidInput([&] { extractOutline(m); }, {"[extractOutline]", "vertex 99999", "3321 vertices"});
+}
+
+// SPEC §4 step 6: lengths checked against the design's. The exact design mesh of a
+// main measures its own lengths; told a design luff 5 % longer, it warns (the
+// luff's σ is millimetres), told one 12 % longer, it stops with the exact reason.
+TEST(SailOutline, LengthsAreCheckedAgainstTheDesign) {
+  const Mesh mesh = generateSailMesh(exampleDesign(SailType::Main));
+  const SailOutline own = extractOutline(mesh);
+  OutlineParams p;
+  p.design_lengths_m = {own.luff_length_m, own.leech_length_m, own.foot_length_m};
+  const SailOutline same = extractOutline(mesh, p);
+  for (const std::string& w : same.warnings) EXPECT_EQ(w.find("than the design"), std::string::npos) << w;
+
+  p.design_lengths_m[0] = 1.05 * own.luff_length_m;
+  const SailOutline short_luff = extractOutline(mesh, p);
+  std::vector<std::string> about_luff;
+  for (const std::string& w : short_luff.warnings)
+    if (w.find("than the design") != std::string::npos) about_luff.push_back(w);
+  ASSERT_EQ(about_luff.size(), 1u);
+  EXPECT_EQ(about_luff[0], "luff length " + formatFixed(own.luff_length_m) + " m is 4.8 % shorter than the design's " +
+                               formatFixed(1.05 * own.luff_length_m) +
+                               " m: the scan may not reach a corner, or the beam's footprint trims a narrow head; the "
+                               "sections sit at fractions of the edges as measured");
+
+  p.design_lengths_m[0] = 1.12 * own.luff_length_m;
+  try {
+    extractOutline(mesh, p);
+    FAIL() << "a luff 10.7 % short was accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_EQ(std::string(e.what()), "[extractOutline] luff length " + formatFixed(own.luff_length_m) +
+                                         " m is 10.7 % off the design " + formatFixed(1.12 * own.luff_length_m) +
+                                         " m (limit 10 %): corners or segmentation are wrong");
+  }
+}
+
+TEST(SailOutline, AClosedSurfaceHasNoBoundary) {
+  Mesh m;
+  m.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  m.triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};  // a tetrahedron, faces outward
+  EXPECT_THROW(extractOutline(m), AnalysisError);
+}
+
+// Flat 3 m x 9 m sheets sampled at random at a 40,000-point mainsail's density
+// (ρ = 1,500 points/m²), each sample moved across the sheet by Gaussian noise of
+// `sigma_x`: the RMS distance (m) of the fitted luff (x = width) and leech (x = 0)
+// from the true edges, away from the corners' rounding, pooled over five sheets.
+double sheetEdgeRms(double sigma_x) {
+  constexpr double kWidth = 3.0, kHeight = 9.0;
+  double sum2 = 0;
+  int n = 0;
+  for (uint64_t seed = 11; seed <= 15; ++seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> x(0.0, kWidth), z(0.0, kHeight);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    Cloud sheet;
+    for (int i = 0; i < 40'500; ++i) sheet.points.emplace_back(x(rng) + sigma_x * noise(rng), 0.0, z(rng));
+    const SailOutline o = extractOutline(reconstructSurface(sheet).mesh);
+    EXPECT_TRUE(o.has_peak) << "seed " << seed;  // a rectangle: four corners
+    for (const auto& [edge, at] : {std::pair{&o.luff, kWidth}, {&o.leech, 0.0}})
+      for (const Vec3& p : *edge)
+        if (p.z() > 0.5 && p.z() < kHeight - 0.5) {
+          sum2 += std::pow(p.x() - at, 2);
+          ++n;
+        }
+  }
+  EXPECT_GT(n, 500);
+  return std::sqrt(sum2 / std::max(1, n));
+}
+
+// The outermost samples along a clean edge lie inside it by random gaps of about
+// a centimetre; a tenth of a degree of twist on an upper section's 0.9 m chord is
+// 1.5 mm. The polynomial resting on the outermost samples (their lower envelope,
+// up to 6 coefficients over the ~8.5 m between the corners' rounding) lies inside
+// the edge by the band holding as many samples as it has coefficients,
+// 6 / (ρ · 8.5 m) = 0.47 mm, with about as much spread once moved out by that:
+// the edges must lie within 1 mm RMS, twice that. (The recess estimated from
+// windows of ~90 samples alone came to 1.16 mm; one least-squares curve through
+// the boundary samples with a single recess, to about 2.6 mm.)
+TEST(SailOutline, EdgesOfRandomlySampledSheetsLieOnTheirTrueEdges) { EXPECT_LT(sheetEdgeRms(0.0), 0.0010); }
+
+// Noise across the edge moves the outermost samples out by its extremes: with
+// 3 mm of it, 2-3σ beyond the edge. The envelope resting on them alone put the
+// edges 3.9 mm out (RMS); the edges must stay within 2.5 mm, under the noise's
+// σ, as the windows' estimates do (each the outermost of ~90 samples, averaged
+// along the edge).
+TEST(SailOutline, NoiseAcrossAnEdgeDoesNotPushItOut) { EXPECT_LT(sheetEdgeRms(0.003), 0.0025); }
+
+TEST(SailOutline, ANotchCutIntoAnEdgeIsNoCorner) {
+  // A 3 m × 9 m sheet (a square top's shape) with a wedge 25 cm deep and 24 cm wide
+  // cut into its leech halfway up, where no samples fell (as when the long-edge
+  // limit leaves a triangle of a sparse scan out). Its tip turns the loop as
+  // sharply as a corner, but inwards: the four corners stay the sheet's.
+  constexpr double kWidth = 3.0, kHeight = 9.0, kDepth = 0.25, kHalfWidth = 0.12;
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> x(0.0, kWidth), z(0.0, kHeight);
+  Cloud sheet;
+  while (sheet.size() < 40'500) {
+    const Vec3 p(x(rng), 0.0, z(rng));
+    if (p.x() < kDepth * (1.0 - std::abs(p.z() - 0.5 * kHeight) / kHalfWidth)) continue;
+    sheet.points.push_back(p);
+  }
+  const SailOutline o = extractOutline(reconstructSurface(sheet).mesh);
+  ASSERT_TRUE(o.has_peak);
+  // The sampled corners lie within a few spacings (2.6 cm) of the sheet's.
+  EXPECT_LT((o.tack - Vec3(kWidth, 0, 0)).norm(), 0.03);
+  EXPECT_LT((o.clew - Vec3(0, 0, 0)).norm(), 0.03);
+  EXPECT_LT((o.head - Vec3(kWidth, 0, kHeight)).norm(), 0.03);
+  EXPECT_LT((o.peak - Vec3(0, 0, kHeight)).norm(), 0.03);
+  for (double t : o.corner_turn_deg) EXPECT_GT(t, 0.0);
+}
+
+// The example main sampled at 40,000 points, every sample within `radius` of its
+// head but the nearest gone.
+constexpr size_t kBareHeadSamples = 40'000;
+LoneTip mainWithABareHead(double radius) {
+  ScanSimulation sim;
+  sim.points = kBareHeadSamples;
+  sim.seed = 5;
+  return isolateTip(sampleSail(exampleDesign(SailType::Main), sim), SailSurface(exampleDesign(SailType::Main)).head(),
+                    radius);
+}
+
+// A mainsail's head whose last samples stand apart: every sample within 50 cm
+// of the head but the one nearest it is gone, and that one is not in the mesh
+// (as when the surface's long-edge trimming leaves a lone tip sample out).
+TEST(SailOutline, AHeadReachesTheLooseSampleTheMeshLeftOut) {
+  const SailSurface truth(exampleDesign(SailType::Main));
+  const Vec3 head = truth.head();
+  const LoneTip cut = mainWithABareHead(0.50);
+  ASSERT_LT(cut.tip_distance_m, 0.05) << "the sampling left no sample near the head";
+  const Vec3& tip = cut.tip;
+  const Cloud& kept = cut.rest;
+  const Mesh mesh = reconstructSurface(kept).mesh;
+
+  const SailOutline without = extractOutline(mesh);
+  const SailOutline with = extractOutline(mesh, {}, {tip});
+  // The head lies at or beyond its outermost sample: along the luff-leech bisector
+  // (here, to well under a degree, straight up) the head reaches the lone sample.
+  const Vec3 up = (head - 0.5 * (truth.luffPoint(0.98) + truth.leechPoint(0.98))).normalized();
+  EXPECT_GE((with.head - tip).dot(up), -0.002) << "head " << with.head.transpose() << ", tip " << tip.transpose();
+  EXPECT_LT((with.head - head).norm(), 0.03);
+  // Without it the head stops short of the sample: the mesh ends 50 cm below the head.
+  EXPECT_LT((without.head - tip).dot(up), -0.005);
+
+  // A point beyond the luff, or off the surface, is no sample of this sail's tip.
+  const Vec3 across = up.cross(truth.luffPoint(0.98) - truth.leechPoint(0.98)).normalized();  // off the surface
+  const Vec3 forward = (truth.luffPoint(0.98) - truth.leechPoint(0.98)).normalized();
+  for (const Vec3& stray : {Vec3(tip + 0.10 * forward), Vec3(tip + 0.05 * across)}) {
+    const SailOutline o = extractOutline(mesh, {}, {stray});
+    EXPECT_LT((o.head - without.head).norm(), 1e-9) << "stray " << stray.transpose();
+  }
+}
+
+// The corners read the tip's gap at the density the loose samples were taken at
+// (a working resolution's mesh is sparser than its scan). An empty wedge beyond the
+// outermost sample is the less likely the denser the scan: at a vast density the head
+// lands on the lone sample itself; at the mesh's own density it lies beyond it.
+TEST(SailOutline, TheDenserTheLooseSamplesTheCloserTheHeadToTheOutermost) {
+  const SailSurface truth(exampleDesign(SailType::Main));
+  const LoneTip cut = mainWithABareHead(0.50);
+  ASSERT_LT(cut.tip_distance_m, 0.05) << "the sampling left no sample near the head";
+  const Mesh mesh = reconstructSurface(cut.rest).mesh;
+  const Vec3 up = (truth.head() - 0.5 * (truth.luffPoint(0.98) + truth.leechPoint(0.98))).normalized();
+  const SailOutline own = extractOutline(mesh, {}, {cut.tip});
+  const SailOutline dense = extractOutline(mesh, {}, {cut.tip}, 1e9);
+  EXPECT_NEAR((dense.head - cut.tip).dot(up), 0.0, 0.002) << "head " << dense.head.transpose();
+  EXPECT_GT((own.head - cut.tip).dot(up), (dense.head - cut.tip).dot(up) + 0.002);
+  // 0 stands for the mesh's own density.
+  EXPECT_EQ(extractOutline(mesh, {}, {cut.tip}, 0.0).head, own.head);
+}
+
+// The example jib sampled cleanly at 40,000 points with no sample within `depth`
+// of its leech from 0.3 to 0.8 m below its head: a stretch where the outermost
+// samples fell deep, as a uniform scatter leaves now and then (a clean jib's
+// leech once had none within 1.7 cm over 0.2 m there).
+Cloud jibWithABareLeechBelowTheHead(uint64_t seed, double depth) {
+  const SailDesign design = exampleDesign(SailType::Jib);
+  const SailSurface truth(design);
+  ScanSimulation sim;
+  sim.points = 40'000;
+  sim.seed = seed;
+  std::vector<Vec3> leech;
+  for (int i = 0; i <= 4000; ++i) leech.push_back(truth.leechPoint(0.9 + 0.1 * i / 4000.0));
+  Cloud kept;
+  for (const Vec3& p : sampleSail(design, sim).points) {
+    const double from_head = (p - truth.head()).norm();
+    double off = std::numeric_limits<double>::infinity();
+    if (from_head >= 0.3 && from_head <= 0.8)
+      for (const Vec3& q : leech) off = std::min(off, (p - q).norm());
+    if (off > depth) kept.points.push_back(p);
+  }
+  return kept;
+}
+
+// The same head with its last 12 cm bare and no lone sample at all: the luff and
+// leech, placed by the outermost samples beside them and carried on to where
+// they cross, put the head within half a sample spacing of the true one. (Their
+// corner curves fitted through the boundary vertices alone stopped 2.4 cm or more
+// short of it here.)
+TEST(SailOutline, AHeadWithItsLastSamplesGoneIsPlacedWhereItsEdgesCross) {
+  const SailDesign design = exampleDesign(SailType::Main);
+  const SailOutline o = extractOutline(reconstructSurface(mainWithABareHead(0.12).rest).mesh);
+  const double spacing = std::sqrt(meshArea(generateSailMesh(design, 200, 100)) / static_cast<double>(kBareHeadSamples));
+  EXPECT_LT((o.head - SailSurface(design).head()).norm(), 0.5 * spacing);
+}
+
+// The head with its leech bare beside it: the leech's frontier windows there lie
+// a centimetre or two inside, and the quadratic through them carried that on to
+// the head, which the luff meets lower. The head must stay within issue 2's
+// 3 cm and within three of its own reported σ. Before the corner curves moved on
+// to the samples' lower envelope, seed 4's came out 3.25 cm low with σ 0.39 cm,
+// and seed 1's 1.72 cm with σ 0.65 cm (its leech had left the envelope, the
+// stretch pulling the mean offset out).
+TEST(SailOutline, ALeechBareOfSamplesBelowTheHeadDoesNotPullTheHeadDown) {
+  const Vec3 head = SailSurface(exampleDesign(SailType::Jib)).head();
+  for (const auto& [seed, depth] : {std::pair<uint64_t, double>{4, 0.015}, {1, 0.02}}) {
+    const SailOutline o = extractOutline(reconstructSurface(jibWithABareLeechBelowTheHead(seed, depth)).mesh);
+    const double error = (o.head - head).norm();
+    EXPECT_LT(error, 0.03) << "seed " << seed;
+    EXPECT_LT(error, 3.0 * o.head_sigma_m) << "seed " << seed << ", σ " << o.head_sigma_m;
+  }
+}
+
+}  // namespace
+}  // namespace sailshape
