@@ -1,7 +1,7 @@
 #pragma once
 // A scan that stops short of the sail's edges by the beam's footprint (SPEC §3:
 // a beam straddling an edge returns a mixed pixel, which the cleaning removes),
-// for the outline's footprint correction (analysis/sail_outline) and for the
+// for the outline's footprint correction (analysis/outline) and for the
 // viewer's re-analysis of a stored scan with its unit's beam.
 #include <cmath>
 #include <random>
