@@ -220,7 +220,8 @@ class CandidateScorer {
 
  private:
   const Cloud& moving_;
-  const std::vector<DetectedPlane>&R_, &M_;
+  const std::vector<DetectedPlane>& R_;  // reference planes
+  const std::vector<DetectedPlane>& M_;  // moving planes
   const PlaneMatchParams& m_;
   const KdTree ref_tree_;
   const std::vector<uint32_t> samples_;
