@@ -44,9 +44,8 @@ double workingVoxel(const Cloud& sail, const AnalysisParams& p) {
 // 40,000 points on a 10 m sail 2 cm columns hold about one on average, and the mean
 // of one or two samples is no better a point than the samples, only fewer of them.
 // Near two a column on average, many hold one and the narrow tips are thinned
-// unevenly: at 100,000-110,000 points (2.05-2.2 a column) one main's head came out
-// 3.4-4.3 cm low where every point put it within 2.1 cm. From three on average,
-// the heads were as close as every point's (bench/independent-sails, 2026-12-02).
+// unevenly, which pulls the corners in by centimetres; from three a column on
+// average the corners stand where every point puts them.
 constexpr double kMinSamplesPerColumn = 3.0;
 
 // The readmit parameters with the pipeline's default offset: 0 means 3 sensor σ.
@@ -128,8 +127,8 @@ std::vector<uint32_t> separateSpars(const Cloud& cloud, const std::vector<Vec3>&
     if (v.norm() > 0) v.normalize();
   // A loose point 3σ-6σ off a spar's surface is the sail's edge strip when it lies on the
   // sail's side of the spar, within 60°. On another side it is more likely one of the
-  // spar's own points that noise put out so far (one in a few hundred): one such came back
-  // into a sparse sweep's sail as a point of its surface and took the tack 30 cm up the mast.
+  // spar's own points that noise put out so far (one in a few hundred): taken into a
+  // sparse sweep's sail as a point of its surface, it can draw the tack up the mast.
   auto offSpar = [&](uint32_t i) {
     const auto [d, s] = to_spar[i];
     if (!std::isfinite(d) || d <= 3 * sigma) return false;
@@ -237,7 +236,9 @@ Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p) {
   return selectPoints(scan, removeMixedPixels(scan, mixedPixelParams(p)).kept);
 }
 
-SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
+namespace {
+
+void checkAnalysisParams(const Cloud& input, const AnalysisParams& p) {
   if (input.empty()) throw InvalidInput("[analyzeSail] empty cloud");
   for (size_t i = 0; i < input.size(); ++i)
     if (!input.points[i].allFinite())
@@ -261,69 +262,75 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     checkSectionParams(sp);
   }
   if (p.mixed_pixels) checkMixedPixelParams(mixedPixelParams(p));
-  SailAnalysis a;
-  a.points_in = input.size();
-  Cloud cloud = input;
+}
 
-  if (looksForMixedPixels(cloud, p)) {
-    StageTimer t(a, "mixed pixels", cloud.size());
-    const Cleaning c = removeMixedPixels(cloud, mixedPixelParams(p));
-    cloud = selectPoints(cloud, c.kept);
-    t.finish(cloud.size(), c.warnings);
+// The segmentation stage: `cloud` becomes the sail cluster, with its fringe, less
+// any spars beside it. Clusters and spars go to `a`.
+void segmentSail(Cloud& cloud, const AnalysisParams& p, const Progress& progress, SailAnalysis& a) {
+  StageTimer t(a, "segmentation", cloud.size());
+  // Work on a voxel-grid sample when the scan is denser than the voxel.
+  const double voxel = p.segmentation_voxel_sigmas * p.sensor_sigma_m;
+  const bool thin = voxel > 0 && medianNeighbourDistanceBelow(cloud.points, 0.8 * voxel);
+  VoxelMeans sample;
+  if (thin) sample = voxelMeans(cloud, voxel);
+  const Cloud& seg_cloud = thin ? sample.cloud : cloud;
+  const size_t k = static_cast<size_t>(std::max(p.normals.k_neighbours, p.region_growing.k_neighbours));
+  const NeighbourTable seg_table = nearestNeighbours(seg_cloud.points, k, progress);
+  const NormalEstimation normals = estimateNormals(seg_cloud, seg_table, p.normals, progress);
+  const Segmentation seg = growRegions(seg_cloud, normals.normals, seg_table, p.region_growing, progress);
+  const SailPick pick = pickSailCluster(seg_cloud, seg, p.sail_pick);
+  a.clusters = pick.candidates;
+  std::vector<uint32_t> idx = addClusterFringe(seg, pick.cluster, seg_table);
+  if (p.find_spars) idx = separateSpars(seg_cloud, normals.normals.normals, seg, idx, p, a);
+  if (thin) {
+    std::vector<char> in(sample.cloud.size(), 0);
+    for (uint32_t v : idx) in[v] = 1;
+    idx.clear();
+    for (uint32_t i = 0; i < cloud.size(); ++i)
+      if (in[sample.voxel_of[i]]) idx.push_back(i);
   }
+  cloud = selectPoints(cloud, idx);
+  std::vector<std::string> w = normals.warnings;
+  w.insert(w.end(), seg.warnings.begin(), seg.warnings.end());
+  w.insert(w.end(), pick.warnings.begin(), pick.warnings.end());
+  t.finish(cloud.size(), w);
+}
 
-  if (p.segment) {
-    StageTimer t(a, "segmentation", cloud.size());
-    // Work on a voxel-grid sample when the scan is denser than the voxel.
-    const double voxel = p.segmentation_voxel_sigmas * p.sensor_sigma_m;
-    const bool thin = voxel > 0 && medianNeighbourDistanceBelow(cloud.points, 0.8 * voxel);
-    VoxelMeans sample;
-    if (thin) sample = voxelMeans(cloud, voxel);
-    const Cloud& seg_cloud = thin ? sample.cloud : cloud;
-    const size_t k = static_cast<size_t>(std::max(p.normals.k_neighbours, p.region_growing.k_neighbours));
-    const NeighbourTable seg_table = nearestNeighbours(seg_cloud.points, k, progress);
-    const NormalEstimation normals = estimateNormals(seg_cloud, seg_table, p.normals, progress);
-    const Segmentation seg = growRegions(seg_cloud, normals.normals, seg_table, p.region_growing, progress);
-    const SailPick pick = pickSailCluster(seg_cloud, seg, p.sail_pick);
-    a.clusters = pick.candidates;
-    std::vector<uint32_t> idx = addClusterFringe(seg, pick.cluster, seg_table);
-    if (p.find_spars) idx = separateSpars(seg_cloud, normals.normals.normals, seg, idx, p, a);
-    if (thin) {
-      std::vector<char> in(sample.cloud.size(), 0);
-      for (uint32_t v : idx) in[v] = 1;
-      idx.clear();
-      for (uint32_t i = 0; i < cloud.size(); ++i)
-        if (in[sample.voxel_of[i]]) idx.push_back(i);
-    }
-    cloud = selectPoints(cloud, idx);
-    std::vector<std::string> w = normals.warnings;
-    w.insert(w.end(), seg.warnings.begin(), seg.warnings.end());
-    w.insert(w.end(), pick.warnings.begin(), pick.warnings.end());
-    t.finish(cloud.size(), w);
-  }
-
-  // The sail's own samples, with their scan angles, when the sweep lost lines: a
-  // corner's line is the line of the sail sample nearest it (not the boom's below a tack).
-  Cloud sail_scan;
-  if (!input.lost_beta_rad.empty()) sail_scan = cloud;
-
-  // How many scan points each working point stands for (empty: one each), and the
-  // scan's own sail points when the working points are column means.
+// What the working resolution leaves beside the working points: how many scan
+// points each stands for (empty: one each), and the scan's own sail points when
+// the working points are column means (empty otherwise).
+struct WorkingResolution {
   std::vector<uint32_t> represents;
   std::vector<Vec3> scan_points;
-  if (const double voxel = workingVoxel(cloud, p); voxel > 0) {
-    StageTimer t(a, "working resolution", cloud.size());
-    VoxelMeans merged =
-        columnMeans(cloud, principalAxes(cloud.points).axes, voxel, p.working_column_depth_sigmas * p.sensor_sigma_m);
-    if (static_cast<double>(merged.cloud.size()) * kMinSamplesPerColumn <= static_cast<double>(cloud.size())) {
-      scan_points = std::move(cloud.points);
-      cloud = std::move(merged.cloud);
-      represents = std::move(merged.count);
-      a.working_voxel_m = voxel;
-    }
-    t.finish(cloud.size());
-  }
+};
 
+// The working-resolution stage: `cloud` becomes its column means where the columns
+// hold enough samples to pay.
+WorkingResolution toWorkingResolution(Cloud& cloud, const AnalysisParams& p, SailAnalysis& a) {
+  WorkingResolution w;
+  const double voxel = workingVoxel(cloud, p);
+  if (!(voxel > 0)) return w;
+  StageTimer t(a, "working resolution", cloud.size());
+  VoxelMeans merged =
+      columnMeans(cloud, principalAxes(cloud.points).axes, voxel, p.working_column_depth_sigmas * p.sensor_sigma_m);
+  if (static_cast<double>(merged.cloud.size()) * kMinSamplesPerColumn <= static_cast<double>(cloud.size())) {
+    w.scan_points = std::move(cloud.points);
+    cloud = std::move(merged.cloud);
+    w.represents = std::move(merged.count);
+    a.working_voxel_m = voxel;
+  }
+  t.finish(cloud.size());
+  return w;
+}
+
+// The cleaning stages (statistical and radius outliers, then readmission): `cloud`
+// keeps its sail points; a.working_points and a.sail_points are set. Returns the
+// samples the filters removed and readmission left out, for the corners only: a
+// lone sample near a narrow tip stands apart from the rest and off the plane of
+// its neighbours 10-25 cm back, yet the corner's own surface, fitted over far more
+// of the sail, can still take it (extractOutline tests each).
+std::vector<Vec3> removeOutliers(Cloud& cloud, const std::vector<uint32_t>& represents, const AnalysisParams& p,
+                                 const Progress& progress, SailAnalysis& a) {
   // Cleaning keeps indices into the segmented cloud, so that the points the
   // filters removed only for being sparse can come back afterwards.
   const Cloud segmented = cloud;
@@ -375,17 +382,86 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     a.sail_points = 0;
     for (uint32_t i : kept) a.sail_points += represents[i];
   }
-  // The samples the filters removed and readmission left out, for the corners
-  // only: a lone sample near a narrow tip stands apart from the rest and off the
-  // plane of its neighbours 10-25 cm back, yet the corner's own surface, fitted
-  // over far more of the sail, can still take it (extractOutline tests each).
   std::vector<Vec3> removed;
-  {
-    std::vector<char> in(segmented.size(), 0);
-    for (uint32_t i : kept) in[i] = 1;
-    for (uint32_t i = 0; i < segmented.size(); ++i)
-      if (!in[i]) removed.push_back(segmented.points[i]);
+  std::vector<char> in(segmented.size(), 0);
+  for (uint32_t i : kept) in[i] = 1;
+  for (uint32_t i = 0; i < segmented.size(); ++i)
+    if (!in[i]) removed.push_back(segmented.points[i]);
+  return removed;
+}
+
+// The surface stage: a.mesh from `cloud`; the points it left out join `loose`.
+void meshSurface(const Cloud& cloud, const AnalysisParams& p, const Progress& progress, SailAnalysis& a,
+                 std::vector<Vec3>& loose) {
+  StageTimer t(a, "surface", cloud.size());
+  Surface s = reconstructSurface(cloud, p.surface, progress);
+  a.mesh = std::move(s.mesh);
+  std::vector<char> meshed(cloud.size(), 0);
+  for (uint32_t i : s.vertex_source) meshed[i] = 1;
+  for (size_t i = 0; i < cloud.size(); ++i)
+    if (!meshed[i]) loose.push_back(cloud.points[i]);
+  t.finish(a.mesh.vertices.size(), s.warnings);
+}
+
+// The outline stage: a.outline and a.luff from a.mesh, the corners read from the
+// `loose` points too. `sail_scan`: the sail's own samples when the sweep lost lines.
+void outlineSail(const Cloud& input, const Cloud& sail_scan, const std::vector<Vec3>& scan_points,
+                 const AnalysisParams& p, SailAnalysis& a, std::vector<Vec3>& loose) {
+  StageTimer t(a, "outline", a.mesh.vertices.size());
+  // A column mean at a narrow tip lies up to half a column short of the tip's outermost
+  // samples: the corners read the scan's own points, at the scan's density.
+  double sample_density = 0;
+  if (!scan_points.empty()) {
+    loose.insert(loose.end(), scan_points.begin(), scan_points.end());
+    sample_density = static_cast<double>(a.sail_points) / std::max(1e-12, meshArea(a.mesh));
   }
+  a.outline = extractOutline(a.mesh, p.outline, loose, sample_density, input.viewpoint);
+  for (std::string& w : widenCornersBesideLostLines(a.outline, sail_scan)) a.outline.warnings.push_back(std::move(w));
+  a.luff = measureLuffCurve(a.outline);
+  t.finish(a.outline.boundary.size(), a.outline.warnings);
+}
+
+// The sections stage: a.sections from a.mesh and a.outline, their noise model
+// from the smoothing's neighbourhoods when there was smoothing.
+void measureSections(const AnalysisParams& p, SailAnalysis& a) {
+  StageTimer t(a, "sections", a.mesh.vertices.size());
+  SectionParams sp = p.sections;
+  sp.sensor_sigma_m = p.sensor_sigma_m;
+  if (p.smooth) {
+    sp.noise_correlation_m = a.smoothing_stats.mean_radius_m;
+    // A quadratic fitted to k points of noise σ over a disc is known at its centre to
+    // 2σ/√k (the constant term's variance, 4σ²/k, with the curvature terms free).
+    const Smoothing& sm = a.smoothing_stats;
+    if (sm.k_used > 0) sp.surface_sigma_m = 2.0 * sm.measured_noise_m / std::sqrt(static_cast<double>(sm.k_used));
+  }
+  a.sections = cutSections(a.mesh, a.outline, sp);
+  t.finish(a.sections.sections.size(), a.sections.warnings);
+}
+
+}  // namespace
+
+SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
+  checkAnalysisParams(input, p);
+  SailAnalysis a;
+  a.points_in = input.size();
+  Cloud cloud = input;
+
+  if (looksForMixedPixels(cloud, p)) {
+    StageTimer t(a, "mixed pixels", cloud.size());
+    const Cleaning c = removeMixedPixels(cloud, mixedPixelParams(p));
+    cloud = selectPoints(cloud, c.kept);
+    t.finish(cloud.size(), c.warnings);
+  }
+  if (p.segment) segmentSail(cloud, p, progress, a);
+
+  // The sail's own samples, with their scan angles, when the sweep lost lines: a
+  // corner's line is the line of the sail sample nearest it (not the boom's below a tack).
+  Cloud sail_scan;
+  if (!input.lost_beta_rad.empty()) sail_scan = cloud;
+
+  const WorkingResolution working = toWorkingResolution(cloud, p, a);
+  // The removed samples, and later the smoothed sail points the mesh left out.
+  std::vector<Vec3> loose = removeOutliers(cloud, working.represents, p, progress, a);
 
   if (p.smooth) {
     StageTimer t(a, "smoothing", cloud.size());
@@ -396,46 +472,9 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     a.smoothing_stats = s;
     t.finish(cloud.size(), s.warnings);
   }
-
-  std::vector<Vec3> loose = std::move(removed);  // and the smoothed sail points the mesh left out
-  {
-    StageTimer t(a, "surface", cloud.size());
-    Surface s = reconstructSurface(cloud, p.surface, progress);
-    a.mesh = std::move(s.mesh);
-    std::vector<char> meshed(cloud.size(), 0);
-    for (uint32_t i : s.vertex_source) meshed[i] = 1;
-    for (size_t i = 0; i < cloud.size(); ++i)
-      if (!meshed[i]) loose.push_back(cloud.points[i]);
-    t.finish(a.mesh.vertices.size(), s.warnings);
-  }
-  {
-    StageTimer t(a, "outline", a.mesh.vertices.size());
-    // A column mean at a narrow tip lies up to half a column short of the tip's outermost
-    // samples: the corners read the scan's own points, at the scan's density.
-    double sample_density = 0;
-    if (!scan_points.empty()) {
-      loose.insert(loose.end(), scan_points.begin(), scan_points.end());
-      sample_density = static_cast<double>(a.sail_points) / std::max(1e-12, meshArea(a.mesh));
-    }
-    a.outline = extractOutline(a.mesh, p.outline, loose, sample_density, input.viewpoint);
-    for (std::string& w : widenCornersBesideLostLines(a.outline, sail_scan)) a.outline.warnings.push_back(std::move(w));
-    a.luff = measureLuffCurve(a.outline);
-    t.finish(a.outline.boundary.size(), a.outline.warnings);
-  }
-  {
-    StageTimer t(a, "sections", a.mesh.vertices.size());
-    SectionParams sp = p.sections;
-    sp.sensor_sigma_m = p.sensor_sigma_m;
-    if (p.smooth) {
-      sp.noise_correlation_m = a.smoothing_stats.mean_radius_m;
-      // A quadratic fitted to k points of noise σ over a disc is known at its centre to
-      // 2σ/√k (the constant term's variance, 4σ²/k, with the curvature terms free).
-      const Smoothing& sm = a.smoothing_stats;
-      if (sm.k_used > 0) sp.surface_sigma_m = 2.0 * sm.measured_noise_m / std::sqrt(static_cast<double>(sm.k_used));
-    }
-    a.sections = cutSections(a.mesh, a.outline, sp);
-    t.finish(a.sections.sections.size(), a.sections.warnings);
-  }
+  meshSurface(cloud, p, progress, a, loose);
+  outlineSail(input, sail_scan, working.scan_points, p, a, loose);
+  measureSections(p, a);
   progress("done", 1.0);
   a.sail_cloud = std::move(cloud);
   return a;

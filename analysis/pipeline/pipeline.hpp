@@ -23,7 +23,7 @@ namespace sailshape {
 struct AnalysisParams {
   double sensor_sigma_m = 0.004;   // SPEC §3; feeds smoothing classes and uncertainties
   // A scan that carries its samples' scan angles and the scanner's position loses
-  // its mixed pixels first (analysis/mixed_pixels.hpp). Its sensor_sigma_m follows
+  // its mixed pixels first (analysis/segmentation/mixed_pixels.hpp). Its sensor_sigma_m follows
   // the one above.
   bool mixed_pixels = true;
   MixedPixelParams mixed;
@@ -35,20 +35,17 @@ struct AnalysisParams {
   double segmentation_voxel_sigmas = 5.0;
   // The working resolution (0: off, every sample goes on). With working_voxel_sigmas > 0, after
   // segmentation a scan with three samples or more per column on average goes on as one
-  // point per occupied column, the mean of its samples (and of their attributes). The
-  // columns stand square on the sail's best-fit plane, working_voxel_sigmas sensor σ
-  // wide but never wider than working_voxel_of_extent times the sail's bounding-box
-  // diagonal, so a model-scale sail keeps its detail (the accuracy targets are met on
-  // 40,000-point scans of a 10 m sail, 2.2 cm or 1/480 of its 10.6 m diagonal apart).
-  // A column whose samples lie more than working_column_depth_sigmas σ apart along the
-  // plane's normal (the surface steeper than about 45° to the plane there, or two
-  // sheets over one another) keeps every sample. The corners still read the scan's own
-  // outermost samples. At 5 (2 cm, the default) a 200,000-point scan of a 10 m main is
-  // analysed 3.4 times as fast, and closer to the truth: the mean of the samples in a
-  // column is as good a point as a smoothing over them (bench/README.md, 2026-12-02).
-  // (Cube voxels, before then, cut a noisy surface's samples apart by their noise where
-  // a voxel face ran along it; their means lay about ±0.8σ off the surface, and entry
-  // angles on dense scans came out up to 3° off.)
+  // point per occupied column, the mean of its samples (and of their attributes): as good
+  // a point as a smoothing over them, and fewer points to carry. The columns stand square
+  // on the sail's best-fit plane (square columns, not cube voxels: a cube's face running
+  // along a noisy surface would cut its samples apart by their noise and put the means
+  // off the surface), working_voxel_sigmas sensor σ wide (5: 2 cm) but never wider than
+  // working_voxel_of_extent times the sail's bounding-box diagonal, so a model-scale sail
+  // keeps its detail (a 40,000-point scan of a 10 m sail has its points 2.2 cm, 1/480 of
+  // its 10.6 m diagonal, apart). A column whose samples lie more than
+  // working_column_depth_sigmas σ apart along the plane's normal (the surface steeper
+  // than about 45° to the plane there, or two sheets over one another) keeps every
+  // sample. The corners still read the scan's own outermost samples.
   double working_voxel_sigmas = 5;
   double working_column_depth_sigmas = 12;
   double working_voxel_of_extent = 1.0 / 500;

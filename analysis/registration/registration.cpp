@@ -101,132 +101,157 @@ struct Candidate {
   size_t planes_on = 0;  // moving planes lying on a matching reference plane
 };
 
-// The study's coarse alignment from matched planes, chosen among every
-// consistent match by how many moving points it brings near the reference.
-RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
-                              const Progress& progress, Registration& out, std::vector<PlaneAnchor>& anchors) {
-  const PlaneDetection dr = detectPlanes(reference, p.planes, progress);
-  const PlaneDetection dm = detectPlanes(moving, p.planes, progress);
-  for (const auto& w : dr.warnings) out.warnings.push_back("reference planes: " + w);
-  for (const auto& w : dm.warnings) out.warnings.push_back("moving planes: " + w);
-  out.reference_planes = dr.planes.size();
-  out.moving_planes = dm.planes.size();
-  const bool pair_translation = p.pairs.size() == 1;
-  const size_t need = pair_translation ? 2 : 3;
-  const std::string need_text = pair_translation ? "two non-parallel planes (with the picked pair)"
-                                                 : "three planes whose normals are independent";
-  for (const auto* d : {&dr, &dm}) {
-    const char* which = d == &dr ? "reference" : "moving";
-    if (d->planes.size() < need)
-      throw AnalysisError(std::string("[registerClouds] fewer than ") + (need == 3 ? "three" : "two") +
-                          " usable planes in the " + which + " cloud (found " + std::to_string(d->planes.size()) +
-                          ": " + describePlanes(d->planes) + "); the plane method needs " + need_text +
-                          " — scan more of the walls/deck, add a reference object, or use --method svd");
+// Whether planes' normals are far enough apart to fix a rotation: a pair, or a
+// triple whose normals are independent too.
+struct PlaneIndependence {
+  const PlaneMatchParams& m;
+  bool pair(const Vec3& a, const Vec3& b) const { return lineAngleDeg(a, b) >= m.min_plane_angle_deg; }
+  bool triple(const Vec3& a, const Vec3& b, const Vec3& c) const {
+    return pair(a, b) && pair(a, c) && pair(b, c) && std::abs(det3(a, b, c)) >= m.min_triple_det;
   }
-  const PlaneMatchParams& m = p.match;
-  auto usablePair = [&](const Vec3& a, const Vec3& b) { return lineAngleDeg(a, b) >= m.min_plane_angle_deg; };
-  auto usableTriple = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
-    return usablePair(a, b) && usablePair(a, c) && usablePair(b, c) && std::abs(det3(a, b, c)) >= m.min_triple_det;
-  };
-  // Reference combinations: hints, or every usable pair/triple (largest planes first).
-  std::vector<std::vector<size_t>> ref_sets, mov_sets_hinted;
+  // The planes s (two or three indices into `planes`).
+  bool of(const std::vector<DetectedPlane>& planes, const std::vector<size_t>& s) const {
+    return s.size() == 2 ? pair(planes[s[0]].normal, planes[s[1]].normal)
+                         : triple(planes[s[0]].normal, planes[s[1]].normal, planes[s[2]].normal);
+  }
+};
+
+// The plane sets a match may pair: the hinted ones (one reference set and its
+// moving set), or every usable reference pair/triple (largest planes first) with
+// no moving set (every ordered one is tried). `need`: planes per set (2 or 3).
+struct PlaneSets {
+  std::vector<std::vector<size_t>> reference, moving_hinted;
+};
+
+PlaneSets planeSets(const Cloud& reference, const Cloud& moving, const PlaneDetection& dr, const PlaneDetection& dm,
+                    const RegistrationParams& p, const PlaneIndependence& independent, size_t need,
+                    const std::string& need_text) {
   const auto& R = dr.planes;
   const auto& M = dm.planes;
+  PlaneSets sets;
   if (!p.plane_hints.empty()) {
     std::vector<size_t> rs, ms;
     for (const PointPair& h : p.plane_hints) {
       rs.push_back(planeNearest(reference, R, h.reference, "reference"));
       ms.push_back(planeNearest(moving, M, h.moving, "moving"));
     }
-    ref_sets.push_back(rs);
-    mov_sets_hinted.push_back(ms);
+    sets.reference.push_back(rs);
+    sets.moving_hinted.push_back(ms);
   } else {
     for (size_t i = 0; i < R.size(); ++i)
       for (size_t j = i + 1; j < R.size(); ++j) {
-        if (!usablePair(R[i].normal, R[j].normal)) continue;
+        if (!independent.pair(R[i].normal, R[j].normal)) continue;
         if (need == 2) {
-          ref_sets.push_back({i, j});
+          sets.reference.push_back({i, j});
           continue;
         }
         for (size_t l = j + 1; l < R.size(); ++l)
-          if (usableTriple(R[i].normal, R[j].normal, R[l].normal)) ref_sets.push_back({i, j, l});
+          if (independent.triple(R[i].normal, R[j].normal, R[l].normal)) sets.reference.push_back({i, j, l});
       }
   }
-  auto independent = [&](const std::vector<DetectedPlane>& planes, const std::vector<size_t>& s) {
-    return s.size() == 2 ? usablePair(planes[s[0]].normal, planes[s[1]].normal)
-                         : usableTriple(planes[s[0]].normal, planes[s[1]].normal, planes[s[2]].normal);
-  };
-  if (ref_sets.empty() || (!p.plane_hints.empty() && !independent(R, ref_sets[0])))
+  if (sets.reference.empty() || (!p.plane_hints.empty() && !independent.of(R, sets.reference[0])))
     throw AnalysisError("[registerClouds] the reference cloud's planes are parallel or their normals share one "
                         "plane (found " + describePlanes(R) + "): the plane method needs " + need_text + " at least " +
-                        formatFixed(m.min_plane_angle_deg, 0) +
+                        formatFixed(independent.m.min_plane_angle_deg, 0) +
                         "° apart; parallel planes leave the rotation about their normal and the translation along "
                         "them undetermined");
-  if (!p.plane_hints.empty() && !independent(M, mov_sets_hinted[0]))
+  if (!p.plane_hints.empty() && !independent.of(M, sets.moving_hinted[0]))
     throw AnalysisError("[registerClouds] the hinted planes of the moving cloud are parallel or their normals share "
                         "one plane: the plane method needs " + need_text);
+  return sets;
+}
 
-  const KdTree ref_tree(reference.points);
-  const std::vector<uint32_t> samples = thin(allIndices(moving.size()), m.verify_samples);
-  const double r2 = m.verify_radius_m * m.verify_radius_m;
-  // Which reference plane each reference point belongs to (R.size(): none).
-  std::vector<uint32_t> ref_label(reference.size(), static_cast<uint32_t>(R.size()));
-  for (size_t j = 0; j < R.size(); ++j)
-    for (uint32_t i : R[j].indices) ref_label[i] = static_cast<uint32_t>(j);
-  std::vector<std::vector<uint32_t>> plane_samples;
-  for (const DetectedPlane& pl : M) plane_samples.push_back(thin(pl.indices, 100));
-  // A candidate scores first by how many moving planes land on a reference
-  // plane of the same orientation with overlapping points (a symmetric chamber
-  // maps walls onto walls either way; the cube and other small planes decide),
-  // then by how many sampled moving points come near the reference.
+// Scores candidate alignments of the moving cloud onto the reference: first by
+// how many moving planes land on a reference plane of the same orientation with
+// overlapping points (a symmetric chamber maps walls onto walls either way; the
+// cube and other small planes decide), then by how many sampled moving points
+// come near the reference.
+class CandidateScorer {
+ public:
+  CandidateScorer(const Cloud& reference, const Cloud& moving, const std::vector<DetectedPlane>& R,
+                  const std::vector<DetectedPlane>& M, const PlaneMatchParams& m)
+      : moving_(moving), R_(R), M_(M), m_(m), ref_tree_(reference.points),
+        samples_(thin(allIndices(moving.size()), m.verify_samples)), r2_(m.verify_radius_m * m.verify_radius_m),
+        ref_label_(reference.size(), static_cast<uint32_t>(R.size())) {
+    for (size_t j = 0; j < R.size(); ++j)
+      for (uint32_t i : R[j].indices) ref_label_[i] = static_cast<uint32_t>(j);
+    for (const DetectedPlane& pl : M) plane_samples_.push_back(thin(pl.indices, 100));
+  }
+
+  // The sampled moving points a score counts among.
+  size_t samples() const { return samples_.size(); }
+
   // The reference plane each moving plane lands on under t (R.size(): none).
-  auto landings = [&](const RigidTransform& t) {
-    std::vector<size_t> on(M.size(), R.size());
+  std::vector<size_t> landings(const RigidTransform& t) const {
+    std::vector<size_t> on(M_.size(), R_.size());
     std::vector<uint32_t> idx;
     std::vector<double> d2;
-    for (size_t k = 0; k < M.size(); ++k) {
-      const Vec3 n = t.linear() * M[k].normal;
-      std::vector<size_t> hits(R.size(), 0);
-      for (uint32_t i : plane_samples[k]) {
-        ref_tree.nearest(t * moving.points[i], 1, idx, d2);
-        if (d2.empty() || d2[0] > r2 || ref_label[idx[0]] == R.size()) continue;
-        if (angleDeg(n, R[ref_label[idx[0]]].normal) <= 2 * m.max_angle_mismatch_deg) ++hits[ref_label[idx[0]]];
+    for (size_t k = 0; k < M_.size(); ++k) {
+      const Vec3 n = t.linear() * M_[k].normal;
+      std::vector<size_t> hits(R_.size(), 0);
+      for (uint32_t i : plane_samples_[k]) {
+        ref_tree_.nearest(t * moving_.points[i], 1, idx, d2);
+        if (d2.empty() || d2[0] > r2_ || ref_label_[idx[0]] == R_.size()) continue;
+        if (angleDeg(n, R_[ref_label_[idx[0]]].normal) <= 2 * m_.max_angle_mismatch_deg) ++hits[ref_label_[idx[0]]];
       }
       const size_t j = static_cast<size_t>(std::max_element(hits.begin(), hits.end()) - hits.begin());
-      if (10 * hits[j] >= plane_samples[k].size() && hits[j] > 0) on[k] = j;
+      if (10 * hits[j] >= plane_samples_[k].size() && hits[j] > 0) on[k] = j;
     }
     return on;
-  };
-  size_t best_planes_on = 0;
-  auto score = [&](const RigidTransform& t, size_t& planes_on) {
+  }
+
+  // The sampled moving points t brings near the reference; the planes it lands
+  // go to planes_on. Scoring in turn, a candidate that lands fewer planes than
+  // the best so far can neither win nor tie: it scores 0 without a point count.
+  size_t score(const RigidTransform& t, size_t& planes_on) {
     std::vector<uint32_t> idx;
     std::vector<double> d2;
     planes_on = 0;
-    for (size_t j : landings(t)) planes_on += j < R.size();
-    // Only a candidate that lands as many planes as the best so far can win or
-    // tie; the others need no point count.
-    if (planes_on < best_planes_on) return size_t{0};
-    best_planes_on = planes_on;
+    for (size_t j : landings(t)) planes_on += j < R_.size();
+    if (planes_on < best_planes_on_) return size_t{0};
+    best_planes_on_ = planes_on;
     size_t count = 0;
-    for (uint32_t i : samples) {
-      ref_tree.nearest(t * moving.points[i], 1, idx, d2);
-      count += !d2.empty() && d2[0] <= r2;
+    for (uint32_t i : samples_) {
+      ref_tree_.nearest(t * moving_.points[i], 1, idx, d2);
+      count += !d2.empty() && d2[0] <= r2_;
     }
     return count;
-  };
+  }
+
+ private:
+  const Cloud& moving_;
+  const std::vector<DetectedPlane>& R_;  // reference planes
+  const std::vector<DetectedPlane>& M_;  // moving planes
+  const PlaneMatchParams& m_;
+  const KdTree ref_tree_;
+  const std::vector<uint32_t> samples_;
+  const double r2_;
+  // Which reference plane each reference point belongs to (R.size(): none).
+  std::vector<uint32_t> ref_label_;
+  std::vector<std::vector<uint32_t>> plane_samples_;  // per moving plane, up to 100 of its points
+  size_t best_planes_on_ = 0;
+};
+
+// Every distinct alignment that maps a moving plane set onto a reference set with
+// the same angles between normals (and handedness), scored. any_moving_set: some
+// set passed the angle test. Reports progress per reference set.
+std::vector<Candidate> matchPlaneSets(const PlaneSets& sets, const std::vector<DetectedPlane>& R,
+                                      const std::vector<DetectedPlane>& M, const RegistrationParams& p,
+                                      const PlaneIndependence& independent, size_t need, CandidateScorer& scorer,
+                                      const Progress& progress, bool& any_moving_set) {
+  const bool pair_translation = p.pairs.size() == 1;
+  const double tol = p.match.max_angle_mismatch_deg;
   auto sameTransform = [](const RigidTransform& a, const RigidTransform& b) {
     return rotationDifferenceDeg(a.linear(), b.linear()) < 1.0 && (a.translation() - b.translation()).norm() < 0.05;
   };
-
   std::vector<Candidate> candidates;
-  bool any_moving_set = false;
-  const double tol = m.max_angle_mismatch_deg;
-  for (size_t s = 0; s < ref_sets.size(); ++s) {
-    progress("plane matching", static_cast<double>(s) / static_cast<double>(ref_sets.size()));
-    const std::vector<size_t>& rs = ref_sets[s];
+  any_moving_set = false;
+  for (size_t s = 0; s < sets.reference.size(); ++s) {
+    progress("plane matching", static_cast<double>(s) / static_cast<double>(sets.reference.size()));
+    const std::vector<size_t>& rs = sets.reference[s];
     std::vector<std::vector<size_t>> mov_sets;
     if (!p.plane_hints.empty()) {
-      mov_sets = mov_sets_hinted;
+      mov_sets = sets.moving_hinted;
     } else {
       for (size_t a = 0; a < M.size(); ++a)
         for (size_t b = 0; b < M.size(); ++b) {
@@ -245,7 +270,7 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
       for (size_t x = 0; x < rs.size() && ok; ++x)
         for (size_t y = x + 1; y < rs.size() && ok; ++y)
           ok = std::abs(angleDeg(R[rs[x]].normal, R[rs[y]].normal) - angleDeg(M[ms[x]].normal, M[ms[y]].normal)) <= tol;
-      if (!ok || !independent(M, ms)) continue;
+      if (!ok || !independent.of(M, ms)) continue;
       if (need == 3 && (det3(R[rs[0]].normal, R[rs[1]].normal, R[rs[2]].normal) > 0) !=
                            (det3(M[ms[0]].normal, M[ms[1]].normal, M[ms[2]].normal) > 0))
         continue;
@@ -269,23 +294,23 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
       bool seen = false;
       for (const Candidate& other : candidates) seen = seen || sameTransform(other.transform, c.transform);
       if (seen) continue;
-      c.score = score(c.transform, c.planes_on);
+      c.score = scorer.score(c.transform, c.planes_on);
       candidates.push_back(c);
     }
   }
   progress("plane matching", 1.0);
-  if (candidates.empty())
-    throw AnalysisError(std::string("[registerClouds] no ") + (need == 3 ? "three" : "two") +
-                        " planes of the moving cloud match the angles between the reference planes within " +
-                        formatFixed(tol, 1) + "° (" + (any_moving_set ? "the third normal disagreed" : "no consistent set") +
-                        "; reference: " + describePlanes(R) + "; moving: " + describePlanes(M) +
-                        ") — give plane hints or picked pairs");
-  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
-    return a.planes_on != b.planes_on ? a.planes_on > b.planes_on : a.score > b.score;
-  });
+  return candidates;
+}
+
+// The best candidate's diagnostics into `out`: its overlap, its plane pairings,
+// and whether another candidate does about as well (an ambiguous match).
+// `candidates` are sorted best first.
+void reportPlaneMatch(const std::vector<Candidate>& candidates, const std::vector<DetectedPlane>& R,
+                      const std::vector<DetectedPlane>& M, const PlaneMatchParams& m, size_t need, size_t samples,
+                      Registration& out) {
   const Candidate& best = candidates.front();
   out.candidates = candidates.size();
-  out.coarse_overlap_fraction = static_cast<double>(best.score) / static_cast<double>(samples.size());
+  out.coarse_overlap_fraction = static_cast<double>(best.score) / static_cast<double>(samples);
   out.coarse_planes_on = best.planes_on;
   for (size_t x = 0; x < need; ++x) {
     PlanePairing pp;
@@ -310,8 +335,54 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
                            ") on the reference; give plane hints or a picked pair");
     break;
   }
+}
+
+// The study's coarse alignment from matched planes, chosen among every
+// consistent match by how many moving points it brings near the reference.
+RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
+                              const Progress& progress, Registration& out, std::vector<PlaneAnchor>& anchors) {
+  const PlaneDetection dr = detectPlanes(reference, p.planes, progress);
+  const PlaneDetection dm = detectPlanes(moving, p.planes, progress);
+  for (const auto& w : dr.warnings) out.warnings.push_back("reference planes: " + w);
+  for (const auto& w : dm.warnings) out.warnings.push_back("moving planes: " + w);
+  out.reference_planes = dr.planes.size();
+  out.moving_planes = dm.planes.size();
+  const bool pair_translation = p.pairs.size() == 1;
+  const size_t need = pair_translation ? 2 : 3;
+  const std::string need_text = pair_translation ? "two non-parallel planes (with the picked pair)"
+                                                 : "three planes whose normals are independent";
+  for (const auto* d : {&dr, &dm}) {
+    const char* which = d == &dr ? "reference" : "moving";
+    if (d->planes.size() < need)
+      throw AnalysisError(std::string("[registerClouds] fewer than ") + (need == 3 ? "three" : "two") +
+                          " usable planes in the " + which + " cloud (found " + std::to_string(d->planes.size()) +
+                          ": " + describePlanes(d->planes) + "); the plane method needs " + need_text +
+                          " — scan more of the walls/deck, add a reference object, or use --method svd");
+  }
+  const PlaneMatchParams& m = p.match;
+  const PlaneIndependence independent{m};
+  const auto& R = dr.planes;
+  const auto& M = dm.planes;
+  const PlaneSets sets = planeSets(reference, moving, dr, dm, p, independent, need, need_text);
+
+  CandidateScorer scorer(reference, moving, R, M, m);
+  bool any_moving_set = false;
+  std::vector<Candidate> candidates =
+      matchPlaneSets(sets, R, M, p, independent, need, scorer, progress, any_moving_set);
+  if (candidates.empty())
+    throw AnalysisError(std::string("[registerClouds] no ") + (need == 3 ? "three" : "two") +
+                        " planes of the moving cloud match the angles between the reference planes within " +
+                        formatFixed(m.max_angle_mismatch_deg, 1) + "° (" +
+                        (any_moving_set ? "the third normal disagreed" : "no consistent set") +
+                        "; reference: " + describePlanes(R) + "; moving: " + describePlanes(M) +
+                        ") — give plane hints or picked pairs");
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return a.planes_on != b.planes_on ? a.planes_on > b.planes_on : a.score > b.score;
+  });
+  reportPlaneMatch(candidates, R, M, m, need, scorer.samples(), out);
+  const Candidate& best = candidates.front();
   // Every moving plane that lands on a reference plane anchors the refinement.
-  const std::vector<size_t> on = landings(best.transform);
+  const std::vector<size_t> on = scorer.landings(best.transform);
   for (size_t k = 0; k < M.size(); ++k) {
     if (on[k] == R.size()) continue;
     PlaneAnchor a;

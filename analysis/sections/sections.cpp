@@ -34,8 +34,8 @@ struct Frame {
 // chord of the curved sail: a straight edge L long sags κL²/8 below the surface
 // (1-3 mm at the luff of a gennaker's upper sections, where its boundary
 // triangles are 10-15 cm long and the section turns fast), and the entry and
-// exit angles, read from the last tenth of the chord, follow such dips: a clean
-// 40,000-point gennaker's entry at 3/4 came out 1.5° off. The edge is taken as
+// exit angles, read from the last tenth of the chord, follow such dips (by a degree
+// or more on a clean gennaker's upper sections). The edge is taken as
 // the cubic that leaves each end along the surface (the end's tangent plane,
 // from its vertex normal: a PN-triangle edge), which lies on a circular arc to
 // O(L⁴); the crossing is that cubic's, found by bisection between its ends.
@@ -477,15 +477,10 @@ struct SectionGeometry {
   std::vector<Vec3> normals;
 };
 
-// One section at fraction t, per SPEC §5; warnings about it go to `warnings`.
-// Throws AnalysisError when it cannot be measured (cutSections lists it unmeasured).
-Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const SectionGeometry& g,
-                       std::vector<std::string>& warnings) {
-  const SailOutline& outline = g.outline;
-  const Vec3& corner_normal = g.corner_normal;
-  const double spacing = g.spacing, sigma_luff = g.sigma_luff, sigma_ends = g.sigma_ends;
-  Section s;
-  s.fraction = t;
+// The chord of the section at fraction t: its luff and leech points, length and
+// direction (f.y_hat and f.m are left for the plane). Throws AnalysisError when
+// there is none.
+Frame sectionChord(double t, const SailOutline& outline, const SectionParams& p) {
   Frame f;
   f.L = pointAtFraction(outline.luff, t);
   if (p.plane == "horizontal") {
@@ -507,13 +502,36 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
   f.chord = (f.R - f.L).norm();
   if (f.chord <= 0) throw AnalysisError("[cutSections] zero chord at fraction " + formatFixed(t, 3));
   f.c_hat = (f.R - f.L) / f.chord;
-  Vec3 m0 = p.plane == "horizontal" ? Vec3::UnitZ() : f.c_hat.cross(corner_normal);
-  if (m0.norm() < 1e-9) m0 = f.c_hat.cross(Vec3::UnitZ());
-  m0.normalize();
-  const Vec3 e0 = f.c_hat.cross(m0);
+  return f;
+}
 
-  double phi = 0;
+// A section plane through the chord, tilted about it by phi (rad) from the
+// starting plane, with the curve it cuts from the sail.
+struct SectionPlane {
+  Frame f;
   Cut cut;
+  double phi = 0;
+  bool converged = false;  // the plane stands along the surface normal at the crest (or needs not)
+};
+
+// The section plane at fraction t through the chord `chord` (from sectionChord):
+// the starting plane (square to the corners' plane, or horizontal), and with
+// plane "normal" the tilt about the chord that brings it along the surface normal
+// at the crest. Warnings about it go to `warnings`; throws AnalysisError when the
+// starting plane finds no curve spanning the chord.
+SectionPlane findSectionPlane(double t, const Mesh& mesh, const SectionParams& p, const SectionGeometry& g,
+                              const Frame& chord, std::vector<std::string>& warnings) {
+  const Frame& f0 = chord;
+  Vec3 m0 = p.plane == "horizontal" ? Vec3::UnitZ() : f0.c_hat.cross(g.corner_normal);
+  if (m0.norm() < 1e-9) m0 = f0.c_hat.cross(Vec3::UnitZ());
+  m0.normalize();
+  const Vec3 e0 = f0.c_hat.cross(m0);
+
+  SectionPlane plane;
+  plane.f = f0;
+  Frame& f = plane.f;
+  double& phi = plane.phi;
+  Cut& cut = plane.cut;
   // The cut at rotation `angle` about the chord; false (and f, cut as they were)
   // when that plane finds no curve spanning the chord.
   std::string why;
@@ -530,61 +548,67 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
     return true;
   };
   if (!cutAt(0)) throw AnalysisError("[cutSections] the section plane at fraction " + formatFixed(t, 3) + " " + why);
-  s.converged = true;
-  if (p.plane == "normal") {
-    s.converged = false;
-    // A tilted plane that loses the curve (it leaves the sail through a hole or an
-    // uncovered end) ends the search at the last plane that held it.
-    auto tiltTo = [&](double angle) {
-      if (cutAt(angle)) return true;
-      warnings.push_back("section " + formatFixed(t, 3) + ": the plane tilted " +
-                         formatFixed(angle * kDegPerRad, 1) + " deg " + why + "; kept at " +
-                         formatFixed(phi * kDegPerRad, 1) + " deg");
-      return false;
-    };
-    for (int it = 0; it < p.max_iterations; ++it) {
-      const auto xy = toChordCoords(cut, f);
-      const size_t imax = maxDepthIndex(xy, f.chord);
-      const uint32_t tri = cut.triangles[std::min(imax, cut.triangles.size() - 1)];
-      const Vec3 n = surfaceNormalNear(mesh, cut.points[imax], p.normal_radius * f.chord, tri);
-      const Vec3 e = f.c_hat.cross(f.m);
-      const double out_of_plane = std::asin(std::clamp(f.m.dot(n), -1.0, 1.0)) * kDegPerRad;
-      if (std::abs(out_of_plane) <= p.normal_tolerance_deg) {
-        s.converged = true;
-        break;
-      }
-      const double en = e.dot(n);
-      if (std::abs(en) < 1e-9) break;
-      const double next = phi + std::atan(-f.m.dot(n) / en);
-      if (std::abs(next) * kDegPerRad > p.max_tilt_deg) {
-        tiltTo(std::copysign(p.max_tilt_deg / kDegPerRad, next));
-        break;
-      }
-      if (!tiltTo(next)) break;
-    }
-    if (!s.converged)
-      warnings.push_back("section " + formatFixed(t, 3) + ": the plane did not reach the surface normal within " +
-                         std::to_string(p.normal_tolerance_deg) + " deg");
-  }
-  s.plane_tilt_deg = phi * kDegPerRad;
-  s.plane_normal = f.m;
-  s.luff_point = f.L;
-  s.leech_point = f.R;
-  const auto xy = toChordCoords(cut, f);
-  s.curve_samples = xy.size();
-  auto bridged = [&](double x) {
-    for (const Bridge& b : cut.bridges)
-      if (x > b.x0 && x < b.x1) return true;
+  plane.converged = true;
+  if (p.plane != "normal") return plane;
+  plane.converged = false;
+  // A tilted plane that loses the curve (it leaves the sail through a hole or an
+  // uncovered end) ends the search at the last plane that held it.
+  auto tiltTo = [&](double angle) {
+    if (cutAt(angle)) return true;
+    warnings.push_back("section " + formatFixed(t, 3) + ": the plane tilted " +
+                       formatFixed(angle * kDegPerRad, 1) + " deg " + why + "; kept at " +
+                       formatFixed(phi * kDegPerRad, 1) + " deg");
     return false;
   };
-  for (const Bridge& b : cut.bridges) s.bridged_pct += 100.0 * (b.x1 - b.x0) / f.chord;
-  if (!cut.bridges.empty())
-    warnings.push_back("section " + formatFixed(t, 3) + ": a hole in the scan, " +
-                              formatFixed(s.bridged_pct, 0) + " % of the chord, is bridged");
+  for (int it = 0; it < p.max_iterations; ++it) {
+    const auto xy = toChordCoords(cut, f);
+    const size_t imax = maxDepthIndex(xy, f.chord);
+    const uint32_t tri = cut.triangles[std::min(imax, cut.triangles.size() - 1)];
+    const Vec3 n = surfaceNormalNear(mesh, cut.points[imax], p.normal_radius * f.chord, tri);
+    const Vec3 e = f.c_hat.cross(f.m);
+    const double out_of_plane = std::asin(std::clamp(f.m.dot(n), -1.0, 1.0)) * kDegPerRad;
+    if (std::abs(out_of_plane) <= p.normal_tolerance_deg) {
+      plane.converged = true;
+      break;
+    }
+    const double en = e.dot(n);
+    if (std::abs(en) < 1e-9) break;
+    const double next = phi + std::atan(-f.m.dot(n) / en);
+    if (std::abs(next) * kDegPerRad > p.max_tilt_deg) {
+      tiltTo(std::copysign(p.max_tilt_deg / kDegPerRad, next));
+      break;
+    }
+    if (!tiltTo(next)) break;
+  }
+  if (!plane.converged)
+    warnings.push_back("section " + formatFixed(t, 3) + ": the plane did not reach the surface normal within " +
+                       std::to_string(p.normal_tolerance_deg) + " deg");
+  return plane;
+}
 
-  // Maximum depth: refined by a cubic through the points around the deepest one.
+// Whether chord coordinate x lies inside one of the bridges (m).
+bool inBridge(const std::vector<Bridge>& bridges, double x) {
+  for (const Bridge& b : bridges)
+    if (x > b.x0 && x < b.x1) return true;
+  return false;
+}
+
+// The section's maximum depth (m, from the chord) and where along the chord it
+// stands (m from the luff point), with their 1σ; side: which side of the chord
+// (±1 along f.y_hat) the crest lies on.
+struct Crest {
+  double side = 1, depth = 0, depth_x = 0, sd_depth = 0, sd_x = 0;
+};
+
+// The crest of the curve xy (chord coordinates, m): the deepest point, refined by
+// a cubic through the points around it. `spacing`: the outline's sample spacing (m),
+// the crest's place's σ when no cubic fits.
+Crest measureCrest(double t, const std::vector<Eigen::Vector2d>& xy, const Frame& f, const Cut& cut,
+                   const SectionParams& p, double spacing, std::vector<std::string>& warnings) {
   const size_t imax = maxDepthIndex(xy, f.chord);
-  const double side = xy[imax].y() >= 0 ? 1.0 : -1.0;
+  Crest c;
+  c.side = xy[imax].y() >= 0 ? 1.0 : -1.0;
+  const double side = c.side;
   double depth = std::abs(xy[imax].y()), depth_x = xy[imax].x();
   double sd_depth = p.sensor_sigma_m, sd_x = spacing;
   {
@@ -606,10 +630,8 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
       // half lies half as far off: twice their difference, less what their noise
       // alone makes of it (for nested least-squares fits, the difference of their
       // variances), estimates the full window's bias, which the draft's σ carries.
-      // On the generator's clean gennakers and mains the draft read 0.4-0.6 % of
-      // chord off with a σ of 0.05-0.07 %. (Taking 2·x_middle − x_full, free of such
-      // a bias, brought those to 0.03 % but put the cubic mean lines of
-      // bench/independent-sails 0.3 % off, where the full window had been right.)
+      // The draft itself stays the full window's: 2·x_middle − x_full, free of
+      // that bias, errs instead where a cubic does follow the crest (a cubic mean line).
       std::vector<Eigen::Vector2d> middle;
       for (const auto& v : win)
         if (std::abs(v.x() - peak_x0) <= 0.5 * half_window) middle.push_back(v);
@@ -633,100 +655,149 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
                          ": no crest in the peak fit; the deepest cut point is used");
     }
   }
-  s.max_camber_point = f.L + depth_x * f.c_hat + side * depth * f.y_hat;
+  c.depth = depth;
+  c.depth_x = depth_x;
+  c.sd_depth = sd_depth;
+  c.sd_x = sd_x;
+  return c;
+}
 
-  // Entry and exit: quadratic over the first / last end_window of chord, slope at the end.
-  // A sparse section (a small sail, the upper sections of a coarse scan) may hold only
-  // a few cut points there; the window then widens until it holds kWantedEndPoints, to
-  // at most twice end_window (a quadratic over 20 % of a sail's mean line leaves its end
-  // slope within about half a degree), with a warning. The cut points lie on the mesh's
-  // flat facets, whose slopes step by about a degree from facet to facet on a curved
-  // section 4 cm apart: six points left a 12,000-point main's upper exit 0.5° spread
-  // (one in twenty over the clean 1° target), ten leave it 0.25°.
-  auto endAngle = [&](bool at_luff, double& sd_deg) {
-    constexpr size_t kMinEndPoints = 6, kWantedEndPoints = 10;
-    const char* const which = at_luff ? "entry" : "exit";
-    std::vector<Eigen::Vector2d> win;
-    const double x_end = at_luff ? 0.0 : f.chord;
-    const double widest = std::min(0.5, 2.0 * p.end_window);
-    double window = p.end_window;
-    for (;;) {
-      win.clear();
-      for (const auto& v : xy)  // measured points only: a bridge is no evidence of the end's slope
-        if (std::abs(v.x() - x_end) <= window * f.chord && !bridged(v.x())) win.emplace_back(v.x(), side * v.y());
-      if (win.size() >= kWantedEndPoints || window >= widest) break;
-      window = std::min(widest, 1.25 * window);
-    }
-    // Fewer even then: five points leave a quadratic two degrees of freedom, and its
-    // end slope came out up to 10° off on a clean 8,000-point mainsail.
-    const QuadFit q = win.size() >= kMinEndPoints ? fitQuadratic(win, x_end, p.surface_sigma_m) : QuadFit{};
-    if (!q.ok) {
-      sd_deg = std::numeric_limits<double>::quiet_NaN();
-      warnings.push_back("section " + formatFixed(t, 3) + ": too few points for the " + which + " angle (" +
-                         std::to_string(win.size()) + " within " + formatFixed(100 * window, 0) +
-                         " % of the chord)");
-      return std::numeric_limits<double>::quiet_NaN();
-    }
-    if (window > p.end_window)
-      warnings.push_back("section " + formatFixed(t, 3) + ": the " + which + " angle is read from " +
-                         std::to_string(win.size()) + " points over " + formatFixed(100 * window, 0) +
-                         " % of the chord (too few within " + formatFixed(100 * p.end_window, 0) + " %)");
-    const double slope = at_luff ? q.c[1] : -q.c[1];
-    const double span = window * f.chord;
-    double inflate = correlationInflation(win.size(), span, p.noise_correlation_m);
-    // A window shorter than the noise's correlation length sees the surface's error
-    // as one smooth tilt, whose slope spreads by the error over that length, not
-    // over the window: σ/span would grow without bound on short chords.
-    if (span < p.noise_correlation_m) inflate *= (span / p.noise_correlation_m) * (span / p.noise_correlation_m);
-    sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDegPerRad;
-    return std::atan(slope) * kDegPerRad;
+// Entry (at_luff) or exit angle (deg): a quadratic over the first / last end_window
+// of chord, its slope at the end; its 1σ (deg, NaN with the angle when too few
+// points) goes to sd_deg. xy: the curve in chord coordinates (m), side: the
+// crest's (Crest::side).
+// A sparse section (a small sail, the upper sections of a coarse scan) may hold only
+// a few cut points there; the window then widens until it holds kWantedEndPoints, to
+// at most twice end_window (a quadratic over 20 % of a sail's mean line leaves its end
+// slope within about half a degree), with a warning. The cut points lie on the mesh's
+// flat facets, whose slopes step by about a degree from facet to facet on a curved
+// section 4 cm apart: ten points average those steps to a quarter of a degree.
+double endAngle(bool at_luff, double t, const std::vector<Eigen::Vector2d>& xy, const Frame& f, double side,
+                const Cut& cut, const SectionParams& p, std::vector<std::string>& warnings, double& sd_deg) {
+  constexpr size_t kMinEndPoints = 6, kWantedEndPoints = 10;
+  const char* const which = at_luff ? "entry" : "exit";
+  std::vector<Eigen::Vector2d> win;
+  const double x_end = at_luff ? 0.0 : f.chord;
+  const double widest = std::min(0.5, 2.0 * p.end_window);
+  double window = p.end_window;
+  for (;;) {
+    win.clear();
+    for (const auto& v : xy)  // measured points only: a bridge is no evidence of the end's slope
+      if (std::abs(v.x() - x_end) <= window * f.chord && !inBridge(cut.bridges, v.x()))
+        win.emplace_back(v.x(), side * v.y());
+    if (win.size() >= kWantedEndPoints || window >= widest) break;
+    window = std::min(widest, 1.25 * window);
+  }
+  // Fewer even then: five points leave a quadratic two degrees of freedom, and its
+  // end slope can err by ten degrees on a clean sail.
+  const QuadFit q = win.size() >= kMinEndPoints ? fitQuadratic(win, x_end, p.surface_sigma_m) : QuadFit{};
+  if (!q.ok) {
+    sd_deg = std::numeric_limits<double>::quiet_NaN();
+    warnings.push_back("section " + formatFixed(t, 3) + ": too few points for the " + which + " angle (" +
+                       std::to_string(win.size()) + " within " + formatFixed(100 * window, 0) +
+                       " % of the chord)");
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  if (window > p.end_window)
+    warnings.push_back("section " + formatFixed(t, 3) + ": the " + which + " angle is read from " +
+                       std::to_string(win.size()) + " points over " + formatFixed(100 * window, 0) +
+                       " % of the chord (too few within " + formatFixed(100 * p.end_window, 0) + " %)");
+  const double slope = at_luff ? q.c[1] : -q.c[1];
+  const double span = window * f.chord;
+  double inflate = correlationInflation(win.size(), span, p.noise_correlation_m);
+  // A window shorter than the noise's correlation length sees the surface's error
+  // as one smooth tilt, whose slope spreads by the error over that length, not
+  // over the window: σ/span would grow without bound on short chords.
+  if (span < p.noise_correlation_m) inflate *= (span / p.noise_correlation_m) * (span / p.noise_correlation_m);
+  sd_deg = std::sqrt(q.cov(1, 1) * inflate) / (1 + slope * slope) * kDegPerRad;
+  return std::atan(slope) * kDegPerRad;
+}
+
+// How the corners' places (each known to its σ along its bisector) move the chord
+// of the section at fraction t: they move its ends along the luff and the leech,
+// the sections standing at arc fractions from the foot (SPEC §5): the luff point by
+// (1 − t) of the tack's shift and t of the head's, the leech point likewise from
+// the clew and the head (or the peak). A shared head moves both ends alike, and its
+// share of a change in the chord (luff point − leech point) cancels as far as the
+// edges run alike.
+class CornerSpread {
+ public:
+  CornerSpread(const SailOutline& outline, double t) {
+    const double top_sigma = outline.has_peak ? outline.peak_sigma_m : 0.0;
+    shifts_[0] = {outline.tack_sigma_m, 1.0 - t, 0.0};
+    shifts_[1] = {outline.clew_sigma_m, 0.0, 1.0 - t};
+    shifts_[2] = {outline.head_sigma_m, t, outline.has_peak ? 0.0 : t};
+    shifts_[3] = {top_sigma, 0.0, t};
+    auto tangentAt = [&](const std::vector<Vec3>& line) {
+      constexpr double kStep = 1e-3;  // of the edge's arc
+      const Vec3 d =
+          pointAtFraction(line, std::min(1.0, t + kStep)) - pointAtFraction(line, std::max(0.0, t - kStep));
+      return d.norm() > 0 ? Vec3(d.normalized()) : Vec3::Zero();
+    };
+    luff_tangent_ = tangentAt(outline.luff);
+    leech_tangent_ = tangentAt(outline.leech);
+  }
+  // 1σ (m) of the chord vector's component along unit d.
+  double sd(const Vec3& d) const {
+    double var = 0;
+    for (const CornerShift& c : shifts_)
+      var += std::pow(c.sigma_m * d.dot(c.luff_share * luff_tangent_ - c.leech_share * leech_tangent_), 2);
+    return std::sqrt(var);
+  }
+
+ private:
+  struct CornerShift {
+    double sigma_m, luff_share, leech_share;
   };
+  CornerShift shifts_[4];
+  Vec3 luff_tangent_, leech_tangent_;
+};
+
+// One section at fraction t, per SPEC §5; warnings about it go to `warnings`.
+// Throws AnalysisError when it cannot be measured (cutSections lists it unmeasured).
+Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const SectionGeometry& g,
+                       std::vector<std::string>& warnings) {
+  const double sigma_luff = g.sigma_luff, sigma_ends = g.sigma_ends;
+  Section s;
+  s.fraction = t;
+  const SectionPlane plane = findSectionPlane(t, mesh, p, g, sectionChord(t, g.outline, p), warnings);
+  const Frame& f = plane.f;
+  const Cut& cut = plane.cut;
+  s.converged = plane.converged;
+  s.plane_tilt_deg = plane.phi * kDegPerRad;
+  s.plane_normal = f.m;
+  s.luff_point = f.L;
+  s.leech_point = f.R;
+  const auto xy = toChordCoords(cut, f);
+  s.curve_samples = xy.size();
+  for (const Bridge& b : cut.bridges) s.bridged_pct += 100.0 * (b.x1 - b.x0) / f.chord;
+  if (!cut.bridges.empty())
+    warnings.push_back("section " + formatFixed(t, 3) + ": a hole in the scan, " +
+                              formatFixed(s.bridged_pct, 0) + " % of the chord, is bridged");
+
+  const Crest crest = measureCrest(t, xy, f, cut, p, g.spacing, warnings);
+  s.max_camber_point = f.L + crest.depth_x * f.c_hat + crest.side * crest.depth * f.y_hat;
 
   SectionParameters& v = s.value;
   SectionParameters& u = s.uncertainty;
   v.chord_m = f.chord;
-  v.camber_pct = 100.0 * depth / f.chord;
-  v.draft_pct = 100.0 * depth_x / f.chord;
+  v.camber_pct = 100.0 * crest.depth / f.chord;
+  v.draft_pct = 100.0 * crest.depth_x / f.chord;
   v.twist_deg = twistDeg(f.L, f.R);
-  v.entry_deg = endAngle(true, u.entry_deg);
-  v.exit_deg = endAngle(false, u.exit_deg);
+  v.entry_deg = endAngle(true, t, xy, f, crest.side, cut, p, warnings, u.entry_deg);
+  v.exit_deg = endAngle(false, t, xy, f, crest.side, cut, p, warnings, u.exit_deg);
   const double chord_dir_sd = sigma_ends / f.chord;  // rad
   const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
-  // The corners' places (each known to its σ along its bisector) move the ends
-  // along the luff and the leech, the sections standing at arc fractions from the
-  // foot (SPEC §5): the luff point by (1 − t) of the tack's shift and t of the
-  // head's, the leech point likewise from the clew and the head (or the peak). A
-  // shared head moves both ends alike, and its share of a change in the chord
-  // (luff point − leech point) cancels as far as the edges run alike. Across the
-  // edges, sigma_ends stands as before.
-  struct CornerShift {
-    double sigma_m, luff_share, leech_share;
-  };
-  const double top_sigma = outline.has_peak ? outline.peak_sigma_m : 0.0;
-  const CornerShift shifts[] = {{outline.tack_sigma_m, 1.0 - t, 0.0},
-                                {outline.clew_sigma_m, 0.0, 1.0 - t},
-                                {outline.head_sigma_m, t, outline.has_peak ? 0.0 : t},
-                                {top_sigma, 0.0, t}};
-  auto tangentAt = [&](const std::vector<Vec3>& line) {
-    constexpr double kStep = 1e-3;  // of the edge's arc
-    const Vec3 d = pointAtFraction(line, std::min(1.0, t + kStep)) - pointAtFraction(line, std::max(0.0, t - kStep));
-    return d.norm() > 0 ? Vec3(d.normalized()) : Vec3::Zero();
-  };
-  const Vec3 luff_tangent = tangentAt(outline.luff), leech_tangent = tangentAt(outline.leech);
-  // 1σ of the chord vector's component along unit d from the corners' places.
-  auto cornerSd = [&](const Vec3& d) {
-    double var = 0;
-    for (const CornerShift& c : shifts)
-      var += std::pow(c.sigma_m * d.dot(c.luff_share * luff_tangent - c.leech_share * leech_tangent), 2);
-    return std::sqrt(var);
-  };
-  u.chord_m = std::hypot(sigma_ends, cornerSd(f.c_hat));
+  // The corners' places move the chord's ends along the edges (CornerSpread);
+  // across the edges, sigma_ends alone.
+  const CornerSpread corners(g.outline, t);
+  u.chord_m = std::hypot(sigma_ends, corners.sd(f.c_hat));
   // The chord line moves by about half the ends' uncertainty at the crest.
-  u.camber_pct = 100.0 * std::sqrt(sd_depth * sd_depth + 0.25 * sigma_ends * sigma_ends) / f.chord;
-  u.draft_pct = 100.0 * std::sqrt(sd_x * sd_x + sigma_luff * sigma_luff) / f.chord;
+  u.camber_pct = 100.0 * std::sqrt(crest.sd_depth * crest.sd_depth + 0.25 * sigma_ends * sigma_ends) / f.chord;
+  u.draft_pct = 100.0 * std::sqrt(crest.sd_x * crest.sd_x + sigma_luff * sigma_luff) / f.chord;
   if (chord_xy > 0) {
     const Vec3 across_xy(-(f.R.y() - f.L.y()) / chord_xy, (f.R.x() - f.L.x()) / chord_xy, 0.0);
-    u.twist_deg = std::hypot(sigma_ends, cornerSd(across_xy)) / chord_xy * kDegPerRad;
+    u.twist_deg = std::hypot(sigma_ends, corners.sd(across_xy)) / chord_xy * kDegPerRad;
   } else {
     u.twist_deg = 180.0;
   }

@@ -173,7 +173,7 @@ Cleaning readmitSurfacePoints(const Cloud& cloud, const std::vector<uint32_t>& k
           // Off the plane by no more than the noise allows, or than the neighbours
           // themselves scatter about it where the surface curves within their reach:
           // a gennaker's head curves 2-5 cm away from the plane of the samples 10-25 cm
-          // below its last ones, which a noise-only test left out, and the head 4.6 cm low.
+          // below its last ones, which a noise-only test would leave out, and the head low.
           const double tol = std::max(p.max_offset_m, 3.0 * plane.rms_m);
           if (std::abs(plane.normal.dot(q) - plane.offset_m) <= tol) back[static_cast<size_t>(c)] = 1;
         }

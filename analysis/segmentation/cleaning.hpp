@@ -55,8 +55,8 @@ struct ReadmitParams {
   double max_offset_m = 0.0;     // must be > 0 here; in AnalysisParams 0 means 3 × sensor σ
   // The last sample of a narrow tip stands out alone: a wedge of angle θ sampled at
   // ρ points/m² stays empty for about 1/√(ρ·tan(θ/2)), 2.4 spacings at a 20° head
-  // and 3.4 at 10°, and ten spacings take in about three times that. (At six, a
-  // main's head sample 7 cm beyond the rest stayed out and the head came 2.5 cm low.)
+  // and 3.4 at 10°, and ten spacings take in about three times that (fewer leave a
+  // head's last sample out, and the head low by centimetres).
   double max_gap_factor = 10.0;
   int passes = 4;
 };

@@ -2,8 +2,8 @@
 // Mixed pixels (SPEC §3): a beam straddling an edge returns a range between the
 // surfaces it straddles. Behind a sail's edge, with another sail or a wall beyond
 // it, such samples hang in the air between the two: a main's head seen against the
-// gennaker behind it grew a fringe 5-15 cm deep, which the outlier filters took for
-// sail and the head was placed 23 cm too high.
+// gennaker behind it grows a fringe centimetres deep, which the outlier filters take
+// for sail, and the corner moves out with it by decimetres.
 //
 // They are found on the scan's own grid, from the samples' scan angles and the
 // scanner's position: along each scan line (α) and across the lines (β), a range

@@ -262,8 +262,9 @@ double flatStripArcDeg(double radius, double band) {
 
 // Gauss–Newton on the axis position (2), direction (2) and radius (1) over the points
 // within `band` of the current surface, re-selecting them each round. On a sparse mast a
-// rough hypothesis holds a metre or so of it; each round takes in a little more, and 12
-// rounds left it holding 90 of 330 points (40 take all, and stop early when converged).
+// rough hypothesis holds a metre or so of it; each round takes in a little more, so a
+// dozen rounds can leave it holding a fraction of the mast (40 take all, and stop early
+// when converged).
 Cylinder refineCylinder(const std::vector<Vec3>& pts, Cylinder c, double band) {
   for (int it = 0; it < 40; ++it) {
     std::vector<const Vec3*> in;
@@ -479,8 +480,8 @@ SparSearch findSpars(const Cloud& cloud, const std::vector<Vec3>& normals, const
     // Two points' normals give a rough cylinder (a few mm of noise in a normal
     // moves a thin spar's axis by centimetres): the best few hypotheses are each
     // refined on their points, and the one the most points then fit wins.
-    // Twelve: in a 3,000-point scene the mast's rough hypotheses ranked below fat cylinders
-    // through its flank and the luff beside it, and six left it out.
+    // Twelve: in a sparse scene the mast's rough hypotheses can rank below fat cylinders
+    // through its flank and the luff beside it, so the best few alone may leave it out.
     constexpr size_t kRefined = 12;
     std::vector<std::pair<size_t, Cylinder>> top;  // (score, hypothesis), best first
     for (int h = 0; h < p.hypotheses; ++h) {

@@ -18,29 +18,29 @@ struct SmoothingParams {
   int k_neighbours = 200;
   // Denser than this (points/m², about a 10 m mainsail at 75,000 points), the k
   // nearest span a smaller patch and the noise left in the fitted slopes grows
-  // as √density / k: 4 mm noise at 200,000 points put exit angles 3° and drafts
-  // 2 % off. There k grows with √density to hold it. 0: k stays fixed.
+  // as √density / k (degrees in the end angles under 4 mm noise at 200,000
+  // points). There k grows with √density to hold it. 0: k stays fixed.
   double reference_density_per_m2 = 4000;
   // Sparser, the k nearest reach so far that the quadratic flattens the sections'
-  // crests: 5,000 points on the 10 m example main (280 points/m²) put 200 of them
-  // within 0.48 m, over half the 0.9 m chord at 3/4 height, and that section's
-  // camber came out 0.45 % low. The radius is held to this fraction of the sail's
-  // size (√ of its area, from the density) by taking fewer neighbours, down to 40:
-  // k ≤ π · ratio² · points, 1.5 % of the sail's points at 0.07: any cloud under
-  // 13,000 points takes fewer than 200. There the bias at 5,000 points falls to
-  // about 0.2 %; at 12,000 (k ≈ 185) the sweeps' end angles are as noisy as
-  // before, and denser clouds are left alone (0.06 flattens a little less at
-  // 5,000 points but adds end-angle noise at 12,000). A cloud noisier for its
-  // size than 4 mm (good_m) on that 18 m² sail gains more from averaging: the
-  // limit grows as (relative noise)^0.2, so a 1:5 wind-tunnel model under 4 mm
-  // noise keeps about the neighbourhood it had without the limit. 0: no limit.
+  // crests: on a 10 m main (280 points/m² at 5,000 points) 200 of them reach
+  // 0.48 m, over half the 0.9 m chord at 3/4 height, and the camber reads low.
+  // The radius is held to this fraction of the sail's size (√ of its area, from
+  // the density) by taking fewer neighbours, down to 40: k ≤ π · ratio² · points,
+  // 1.5 % of the sail's points at 0.07, so any cloud under 13,000 points takes fewer
+  // than 200. The fraction balances the crest's flattening (a larger one) against
+  // the end angles' noise (a smaller one) over sparse clouds; denser clouds are
+  // left alone. A cloud noisier for its size than 4 mm (good_m) on that 18 m² sail
+  // gains more from averaging: the limit grows as (relative noise)^0.2, so a 1:5
+  // wind-tunnel model under 4 mm noise keeps about the neighbourhood it would have
+  // without the limit. 0: no limit.
   double max_radius_ratio = 0.07;
   // Those neighbourhoods are sized for the sensor's noise (good_m). A cloud whose
   // measured noise (the RMS off quadratics through 24 neighbours) is under half of
   // that needs less averaging and takes a smaller one: k shrinks with √(noise /
-  // (good_m / 2)), down to 40. The quadratic's bias grows with the radius, and on a
-  // clean 1:5 model mainsail k = 400 spanned half its 18 cm top chord (exit 2.3°,
-  // twist 0.5° off). false: k as above whatever the noise.
+  // (good_m / 2)), down to 40. The quadratic's bias grows with the radius: on a
+  // clean 1:5 model mainsail 400 neighbours span half its 18 cm top chord, and
+  // its exit angle and twist follow the flattened curve. false: k as above
+  // whatever the noise.
   bool adapt_to_noise = true;
   int polynomial_order = 2;     // 1: plane, 2: quadratic
   // 0: a local surface fitted at every point (MLS proper). > 0: inside the
@@ -48,9 +48,9 @@ struct SmoothingParams {
   // neighbourhood radius apart, each point projected onto a blend of its
   // nearest anchors' (the quadratic carries the curvature across the gap);
   // near edges, where neighbourhoods turn one-sided, and for plane fits
-  // (polynomial_order 1), every point still gets its own fit. At 0.5, 5-6
-  // times fewer fits; points land within ~0.1 mm RMS (< 1 mm max) of plain MLS
-  // under 4 mm noise.
+  // (polynomial_order 1), every point still gets its own fit. At 0.5, about
+  // a fifth of the fits; points land within ~0.1 mm RMS (< 1 mm max) of plain
+  // MLS under 4 mm noise.
   double anchor_ratio = 0.5;
   double good_m = 0.004;        // sensor random error σ (SPEC §3)
   double fair_m = 0.009;        // σ + systematic error: 9 mm at model scale, 14 mm full scale
