@@ -163,12 +163,11 @@ TEST(Pipeline, ASquareHeadUnderAMetreWideKeepsItsFourCorners) {
 
 // A square top's top edge is a short section with its own camber: 1.35 m of
 // chord 13 % deep here, a curve the boundary samples of a few windows cannot
-// place. Fitted as a straight line through its dozen boundary vertices, the top
-// passed 8-10 cm off the surface at the head, and its crossing with the leech
-// came out 2.8-3.8 cm off at the peak on these seeds (5 cm on an independent
-// sail's). Frontier windows an eighth of the edge's reach long (the edge less 3
-// spacings), with their points taken on the surface, follow the camber and meet
-// the luff and the leech where the sail's corners are: within 0.3-2.4 cm here.
+// place. A straight line through its dozen boundary vertices passes several cm off
+// the surface at the head and moves its crossing with the leech, the peak, as far.
+// Frontier windows an eighth of the edge's reach long (the edge less 3 spacings),
+// with their points taken on the surface, follow the camber and meet the luff and
+// the leech where the sail's corners are.
 TEST(Pipeline, ADeepShortTopEdgeMeetsLuffAndLeechAtTheSquareHeadsCorners) {
   SailDesign design = squareTop(13.0, 13.1, 4.6, 1.35);
   design.stations.back().camber_pct = 13;
@@ -177,11 +176,10 @@ TEST(Pipeline, ADeepShortTopEdgeMeetsLuffAndLeechAtTheSquareHeadsCorners) {
 
 // A wider top edge, 2.16 m and 8 % deep, turns more than 0.08 rad over 5 boundary
 // spacings near its ends, more than the frontier's windows follow; so its corners
-// kept the quadratics through the boundary, which the rounded-off ends pull in,
-// and these runs' heads and peaks came out up to 3.9 cm off (3 of 6 over half a
-// sample spacing). Judged over the shorter windows the frontier takes on an edge
-// this short, it turns less than that, and the corners lie within half a spacing
-// (1.6 cm; they came out within 0.2-1.3 cm).
+// would keep the quadratics through the boundary, which the rounded-off ends pull
+// in, and the head and peak with them by more than half a sample spacing. Judged
+// over the shorter windows the frontier takes on an edge this short, it turns less
+// than that, and the corners lie within half a spacing.
 TEST(Pipeline, AWideTopEdgeIsJudgedOverTheFrontierWindowsItWouldTake) {
   SailDesign design = squareTop(11.35, 11.4, 5.0, 2.16);
   design.stations.back().camber_pct = 8;
@@ -193,8 +191,8 @@ TEST(Pipeline, AWideTopEdgeIsJudgedOverTheFrontierWindowsItWouldTake) {
 // A clean scan loses no sample. The radius filter drops a gennaker's last samples
 // near its narrow head (few neighbours there); readmission brings them back only
 // if they lie on the surface of the kept points beyond them, and the head curves
-// 2-5 cm off those points' plane: on this seed ten tip samples stayed out and the
-// head came out 4.6 cm low.
+// 2-5 cm off those points' plane: judged on that plane the tip samples would stay
+// out and the head would lie centimetres low.
 TEST(Pipeline, CleanGennakerKeepsItsTipSamplesAndItsHead) {
   const SailDesign design = exampleDesign(SailType::Gennaker);
   const ScanSimulation sim = scan(40000, 10);
@@ -251,7 +249,7 @@ TEST(Pipeline, GennakerTackHoldsWhereItsFootCurvesAway) {
 // Where few samples fall near an edge, its boundary runs inside it: a notch. One
 // 36 cm long and 4 cm deep cut into the foot from 0.24 m aft of the tack (every
 // sample within 4 cm of the foot there removed) bent the quadratic through the
-// foot's boundary vertices, which put seed 6's tack 4.3 cm off. The foot's samples'
+// foot's boundary vertices and with it the tack, by centimetres. The foot's samples'
 // lower envelope is bounded only where there are samples: beside the notch it
 // follows those before and after it, and the tack stays within the corner target.
 TEST(Pipeline, GennakerTackHoldsBesideANotchInItsFoot) {
@@ -301,10 +299,10 @@ TEST(Pipeline, ASparseGennakersTackFollowsItsFootsTurn) {
 }
 
 // A sparse gennaker's 35° head: its leech's first frontier window (0.8 m long,
-// measured from the corner curve through boundary vertices) lay 2.7 cm out, a cubic
-// followed it, and on these seeds the head came out 5-5.7 cm low. The windows are
-// measured again from the frontier curve. (7 of 20 such heads still lie over 3 cm
-// off: the tip beyond the outermost sample is 7 cm long on average here.)
+// measured from the corner curve through boundary vertices) can lie centimetres out;
+// a cubic following it puts the head as far low. The windows are measured again from
+// the frontier curve. (The tip beyond the outermost sample of such a head is several
+// cm long, so its corner target is the sparse one.)
 TEST(Pipeline, ASparseGennakersHeadComesFromItsFrontierMeasuredTwice) {
   const SailDesign design = exampleDesign(SailType::Gennaker);
   const SailSurface truth(design);
@@ -365,7 +363,7 @@ TEST(Pipeline, GennakerOutlineStaysOutOfAHoleThatTouchesItsLuff) {
 // neighbours) and readmission leaves it out (the plane of its neighbours 20-35 cm
 // back is one the curving head leaves); the corner still counts it, tested on
 // the corner's own surface fitted over far more of the sail. Without it the head
-// came out 3 cm short of the lone sample.
+// would stop short of the lone sample by the gap to the next one.
 TEST(Pipeline, AHeadReachesItsLoneTipSampleThatCleaningRemoved) {
   const SailDesign design = exampleDesign(SailType::Gennaker);
   const SailSurface truth(design);
@@ -489,9 +487,8 @@ using ValueTruthSigma = std::vector<std::tuple<double, double, double>>;
 TEST(Pipeline, NoisyEndAnglesCarryAnUncertaintyThatCoversTheirError) {
   // Under 4 mm noise the cut points near a chord's ends follow the smoothed surface,
   // whose error is smooth over the smoothing radius and hides in the end fits'
-  // residuals: from those alone the entry and exit σ came out about 0.2° against
-  // errors of 0.6° RMS (z = error/σ at 4.4 RMS over these seeds; 0.8 now). For an
-  // exact σ, z over 6 seeds × 3 sections × 2 angles is 1 ± 0.12 RMS; a σ that
+  // residuals: from those alone the entry and exit σ would be a fraction of the
+  // error. For an exact σ, z over 6 seeds × 3 sections × 2 angles is 1 ± 0.12 RMS; a σ that
   // leans to safety stays under 1.5, and one four times the error (z under 0.25)
   // would say nothing.
   const double z_rms = sectionZRms(SailType::Main, 0.004, [](const Section& s, const KnownSection& k) {
@@ -609,8 +606,8 @@ TEST(Pipeline, NoisyJibMeetsTheTargetsWithItsTackOnTheSurface) {
 TEST(Pipeline, DenseNoisyMainsailKeepsItsEndAnglesWithinTheNoiseTargets) {
   // Five times denser than above, every point analysed (working_voxel_sigmas 0): more
   // points must not make it worse. The MLS neighbourhood (a fixed count) then spans a smaller
-  // patch, and an edge point's one-sided quadratic tilts with the noise; on this
-  // seed the top section's exit came out 3.8° off when edge fits used k points, not 2k.
+  // patch, and an edge point's one-sided quadratic tilts with the noise unless edge
+  // fits take 2k points, not k: the top section's exit angle is the first to show it.
   const SailDesign design = exampleDesign(SailType::Main);
   const ScanSimulation sim = scan(200000, 3, 0.004);
   AnalysisParams every_point;
@@ -809,8 +806,7 @@ bool warnsOfScanLinesBeside(const SailAnalysis& a, const std::string& edge) {
 // Scan lines 5 cm apart on the sail run almost along its luff and cross it only
 // where the rake carries it over a line: the samples beside the luff form a
 // staircase up to a line spacing inside it, and the luff is placed by the last
-// line (bench/independent-sails, 2026-12-01: 1-3 cm inside, upper twists 0.4-0.8°
-// off). Where the edge lies between the lines is not in the samples: uniform over a
+// line, up to a spacing inside. Where the edge lies between the lines is not in the samples: uniform over a
 // spacing, σ = spacing / √12. The analysis says so, and its uncertainties cover it.
 TEST(Pipeline, ALuffBesideScanLinesIsSaidSoAndItsUncertaintyCoversALineSpacing) {
   const SailDesign design = exampleDesign(SailType::Main);
@@ -829,8 +825,8 @@ TEST(Pipeline, ALuffBesideScanLinesIsSaidSoAndItsUncertaintyCoversALineSpacing) 
 
 // Where the rake carries the luff over a scan line, the line ends on it: the edge
 // runs through those ends, outside the staircase the last line leaves between
-// them (up to 6 cm inside here). Placed by the outermost samples as a scatter's,
-// the luff came out 1.0 cm inside on both sails; through the ends, 0.1-0.2 cm.
+// them (up to 6 cm inside here). Placed by the outermost samples as a scatter's, the
+// luff would lie inside by about half a line spacing; through the ends it does not.
 TEST(Pipeline, ALuffCrossingItsScanLinesRunsThroughTheirEnds) {
   for (SailType type : {SailType::Main, SailType::SquareTopMain}) {
     SCOPED_TRACE(sailTypeName(type));
@@ -1015,11 +1011,9 @@ TEST(Pipeline, ASparseSquareTopInItsSceneFindsItsSparsAndKeepsItsCorners) {
 }
 
 TEST(Pipeline, AVerySparseSquareTopInItsSceneFindsItsSparsAndKeepsItsCorners) {
-  // 3,000 samples, 9 cm apart. The mast came out in two stretches with its points
-  // between them left in the sail; or ended above its foot, one point below it left
-  // there; or was found only above 4-8 m, because its rough hypotheses refined to a
-  // metre of it, and its samples round its girth, one every 16°, were not taken to go
-  // round it.
+  // 3,000 samples, 9 cm apart: the mast's samples round its girth are one every 16°,
+  // and it must still be found whole, foot to top, with none of its points left in
+  // the sail.
   expectSparseSceneReadsAsTheSailAlone(3000, 18);
 }
 
@@ -1196,9 +1190,9 @@ TEST(Pipeline, ABadSectionParameterIsReportedBeforeAnyWork) {
 }
 
 TEST(Pipeline, ACleanWindTunnelModelKeepsItsTopSectionWithinTheCleanTargets) {
-  // The example mainsail at 1:5 (2 m luff), 20,000 clean samples: the density grew
-  // the smoothing's k past 500, a neighbourhood wider than half the top section's
-  // chord, and its entry and exit came out over 1° off. Measured clean, k stays small.
+  // The example mainsail at 1:5 (2 m luff), 20,000 clean samples: sized by density
+  // alone the smoothing's k would pass 500, a neighbourhood wider than half the top
+  // section's chord, and bend its entry and exit. Measured clean, k stays small.
   const SailDesign design = scaleDesign(exampleDesign(SailType::Main), 0.2);
   const SailAnalysis a = analyzeSail(sampleSail(design, scan(20000)));
   EXPECT_EQ(a.smoothing_stats.k_used, 40u);
