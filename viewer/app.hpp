@@ -1,8 +1,9 @@
 #pragma once
-// The viewer's window content: database browser, 3D view, section table,
-// plots, trim-step comparison, processing tabs. All UI state lives in the
-// structs below; drawing happens in App::frame() between ImGui::NewFrame and
-// ImGui::Render.
+// The viewer's window content: toolbar, database browser, 3D view, plots, and
+// the Sections, Trim steps, Processing, Scanners (with live mode) and Messages
+// tabs. All UI state lives in the structs below; drawing happens in App::frame()
+// between ImGui::NewFrame and ImGui::Render. App's frame and jobs are in
+// app.cpp, each panel in its own *_panel.cpp.
 #include <cstdint>
 #include <array>
 #include <deque>
@@ -168,26 +169,36 @@ class App {
   LiveStatus liveStatus() const { return live_.mode.status(); }
 
  private:
+  // The frame's own work (app.cpp): the database, the scan loads and every job's results.
   void openDatabase(const std::string& path);
   void selectScan(int64_t scan_id);
   void pollJobs();
   void startNextLoad();
-  void drawToolbar(float x, float y, float w, float h);
-  void drawBrowser(float x, float y, float w, float h);
-  void drawDisplayOptions();
-  void drawView(float x, float y, float w, float h);
-  void drawPlots(float x, float y, float w, float h);
-  void drawRightPanel(float x, float y, float w, float h);
-  void drawSectionTable();
-  void drawTrimComparison();
-  void drawProcessing();
-  void drawScanner();
-  void drawLive();
-  void takeLiveResults();
-  TrimStepForm trimStepForm() const;
-  void drawReportPopup();
-  void drawStatus(float x, float y, float w, float h);
   std::vector<Overlay> overlayList() const;
+
+  // The panels, each in the file named after it.
+  void drawToolbar(float x, float y, float w, float h);      // toolbar_panel.cpp
+  void drawReportPopup();                                     // report_panel.cpp
+  void drawBrowser(float x, float y, float w, float h);      // browser_panel.cpp
+  void drawDisplayOptions();
+  void drawView(float x, float y, float w, float h);         // view_panel.cpp
+  void forwardViewInput(float origin_x, float origin_y);
+  void drawViewCaptions(float origin_x, float origin_y, float w, float h);
+  void drawPlots(float x, float y, float w, float h);        // plots_panel.cpp
+  void drawRightPanel(float x, float y, float w, float h);   // app.cpp: the tabs below
+  void drawSectionTable();                                    // sections_panel.cpp
+  void drawTrimComparison();                                  // trim_steps_panel.cpp
+  void drawProcessing();                                      // processing_panel.cpp
+  void startProcessing(ProcessingStage stage);
+  void drawProcessingResult(bool running);
+  void drawScanner();                                         // scanners_panel.cpp
+  void drawUnits();
+  void drawTrimStepFields();
+  TrimStepForm trimStepForm() const;
+  void drawLive();                                            // live_panel.cpp
+  void takeLiveResults();
+  void drawMessages();                                        // status_panel.cpp
+  void drawStatus(float x, float y, float w, float h);
 
   DatabaseState database_;
   BrowserState browser_;

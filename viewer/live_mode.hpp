@@ -35,8 +35,8 @@ RoiBox sailRoi(const Mesh& design, double margin_m = 0.3, double min_z_m = -1e9)
 AnalysisParams designedSailParams(const Mesh& design, int sections, AnalysisParams base = {});
 
 struct LiveParams {
-  // Every sweep homes first (sweep.home): emulated sweeps started from where the last one
-  // ended, without homing, came out distorted (outline lengths 2–28 m for a 10 m luff).
+  // Every sweep homes first (sweep.home): a sweep started where the last one ended,
+  // without homing, distorts the sail's outline.
   SweepOptions sweep;
   SceneOptions scene;                // the analysis of each sweep (scene.roi: the sail's region)
   std::optional<Mesh> design;        // deviation and design sections; none: flying values only

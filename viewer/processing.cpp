@@ -72,9 +72,9 @@ StageResult runStages(const Cloud& input, const ProcessingParams& params, Proces
   r.summary.push_back(count("after ROI", cloud.size()));
   // The surface and sections stages leave the filters to analyzeSail, whose cleaning
   // gives back the surface points they removed and lets the corners test the rest,
-  // as `sailshape analyze` does: filtered here, a narrow head lost its tip (the
-  // statistical test takes a corner's lone samples) and read 5 cm low. The filters
-  // measure distances only, so running them after the transform changes nothing.
+  // as `sailshape analyze` does: filtered here, the statistical test would take a
+  // corner's lone samples and cut a narrow head short. The filters measure
+  // distances only, so running them after the transform changes nothing.
   const bool analyse = stage >= ProcessingStage::Surface;
   if (stage >= ProcessingStage::Filters && !analyse) {
     if (ap.statistical_outliers) {

@@ -155,7 +155,7 @@ Acquisition ScannerSession::scan(const SweepOptions& options, const Progress& pr
     if (s.partial) a.warnings.push_back(s.unit + ": partial sweep (" + s.message + ")");
     for (const auto& w : s.warnings) a.warnings.push_back(s.unit + ": " + w);
     // One unit's sweep keeps where it stood and its samples' scan angles: its mixed
-    // pixels are found on its grid (analysis/mixed_pixels.hpp). Several units'
+    // pixels are found on its grid (analysis/segmentation/mixed_pixels.hpp). Several units'
     // samples share neither.
     if (a.sweeps.size() == 1)
       a.cloud = std::move(s.cloud);

@@ -1,0 +1,101 @@
+// The Database panel: the catalogue tree (campaign, test, trim step, scan) with
+// the overlay ticks, and below it the 3D view's display options.
+#include "viewer/app.hpp"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "viewer/widgets.hpp"
+
+namespace sailshape::viewer {
+
+void App::drawBrowser(float x, float y, float w, float h) {
+  if (beginPanel("Database", x, y, w, h)) {
+    if (!database_.db) {
+      if (!database_.error.empty()) {
+        ImGui::PushTextWrapPos(0);
+        ImGui::TextColored(kErrorText, "%s", database_.error.c_str());
+        ImGui::PopTextWrapPos();
+      } else {
+        ImGui::TextWrapped("No database open. Type a path above and press Open, or start sailshape-viewer DB.");
+      }
+    } else {
+      ImGui::TextColored(kMutedText, "%s", std::filesystem::path(database_.path).filename().c_str());
+      ImGui::SameLine();
+      ImGui::TextColored(kMutedText, "· %zu scans", browser_.tree.scan_count);
+      if (browser_.tree.campaigns.empty()) {
+        ImGui::Spacing();
+        ImGui::TextWrapped("This database has no scans yet. Import some with `sailshape db import`.");
+      }
+      const float tree_h = std::max(80.0f, ImGui::GetContentRegionAvail().y - 250.0f);
+      ImGui::BeginChild("tree", ImVec2(0, tree_h), true);
+      for (const auto& c : browser_.tree.campaigns) {
+        if (!ImGui::TreeNodeEx(c.name.c_str(), ImGuiTreeNodeFlags_DefaultOpen)) continue;
+        for (const auto& t : c.tests) {
+          if (!ImGui::TreeNodeEx((t.label() + "##" + c.name).c_str(), ImGuiTreeNodeFlags_DefaultOpen)) continue;
+          for (const auto& s : t.steps) {
+            const std::string id = s.label() + "##" + c.name + t.name + s.sail + std::to_string(s.step);
+            const bool open = ImGui::TreeNodeEx(id.c_str(), ImGuiTreeNodeFlags_DefaultOpen);
+            if (ImGui::IsItemHovered() && !s.controls.empty())
+              ImGui::SetTooltip("controls: %s%s", s.controls.c_str(),
+                                s.drive_n ? ("\ndrive " + format("%.0f N", *s.drive_n)).c_str() : "");
+            if (!open) continue;
+            for (const auto& scan : s.scans) {
+              ImGui::PushID(static_cast<int>(scan.scan_id));
+              bool overlay = browser_.overlays.count(scan.scan_id) > 0;
+              if (ImGui::Checkbox("##ov", &overlay)) {
+                if (overlay && scan.scan_id != browser_.selected_scan) {
+                  browser_.overlays.insert(scan.scan_id);
+                  load_.overlay_queue.push_back(scan.scan_id);
+                } else {
+                  browser_.overlays.erase(scan.scan_id);
+                  load_.overlays.erase(scan.scan_id);
+                }
+                view_.rebuild = true;
+              }
+              if (ImGui::IsItemHovered()) ImGui::SetTooltip("overlay this trim step on the selected scan");
+              ImGui::SameLine();
+              const std::string label = "scan " + std::to_string(scan.scan_id) + "  " +
+                                        (scan.point_count ? std::to_string(scan.point_count) + " pts" : std::string());
+              if (ImGui::Selectable(label.c_str(), browser_.selected_scan == scan.scan_id)) selectScan(scan.scan_id);
+              ImGui::PopID();
+            }
+            ImGui::TreePop();
+          }
+          ImGui::TreePop();
+        }
+        ImGui::TreePop();
+      }
+      ImGui::EndChild();
+    }
+    drawDisplayOptions();
+  }
+  ImGui::End();
+}
+
+void App::drawDisplayOptions() {
+  ImGui::Spacing();
+  ImGui::TextColored(kAccentText, "Display");
+  ViewOptions& o = view_.options;
+  bool changed = false;
+  changed |= ImGui::Checkbox("design (blue wireframe)", &o.design);
+  changed |= ImGui::Checkbox("flying surface", &o.surface);
+  ImGui::SameLine();
+  changed |= ImGui::Checkbox("raw cloud", &o.cloud);
+  changed |= ImGui::Checkbox("sail cluster", &o.cluster);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("the points segmentation took for the sail, cleaned and smoothed");
+  changed |= ImGui::Checkbox("sections", &o.sections);
+  ImGui::SameLine();
+  changed |= ImGui::Checkbox("design sections", &o.design_sections);
+  changed |= ImGui::Checkbox("section planes", &o.section_planes);
+  changed |= ImGui::Checkbox("deviation colours", &o.deviation);
+  if (o.deviation) {
+    ImGui::SetNextItemWidth(140);
+    changed |= ImGui::SliderFloat("± mm", &o.deviation_range_mm, 0.0f, 300.0f, o.deviation_range_mm > 0 ? "%.0f" : "auto");
+  }
+  ImGui::SetNextItemWidth(140);
+  changed |= ImGui::SliderFloat("point size", &o.point_size, 1.0f, 6.0f, "%.0f");
+  if (changed) view_.rebuild = true;
+}
+
+}  // namespace sailshape::viewer

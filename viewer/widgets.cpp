@@ -1,0 +1,64 @@
+#include "viewer/widgets.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace sailshape::viewer {
+
+ImU32 toU32(const Rgb& c) { return IM_COL32(int(c[0] * 255), int(c[1] * 255), int(c[2] * 255), 255); }
+ImVec4 toVec4(const Rgb& c) { return ImVec4(c[0], c[1], c[2], 1.0f); }
+
+std::string format(const char* fmt, double v) {
+  if (!std::isfinite(v)) return "—";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+std::string signedFormat(const char* fmt, double v) {
+  if (!std::isfinite(v)) return "—";
+  std::string f = std::string("%+") + (fmt + 1);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f.c_str(), v);
+  return buf;
+}
+
+bool beginPanel(const char* name, float x, float y, float w, float h, ImGuiWindowFlags extra) {
+  constexpr ImGuiWindowFlags kPanelFlags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
+                                           ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
+  ImGui::SetNextWindowPos(ImVec2(x, y));
+  ImGui::SetNextWindowSize(ImVec2(std::max(w, 1.0f), std::max(h, 1.0f)));
+  return ImGui::Begin(name, nullptr, kPanelFlags | extra);
+}
+
+void helpMarker(const char* text) {
+  ImGui::SameLine();
+  ImGui::TextDisabled("(?)");
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
+}
+
+bool inputInt(const char* label, int* v, int lo, int hi) {
+  const bool changed = ImGui::InputInt(label, v);
+  *v = std::clamp(*v, lo, hi);
+  return changed;
+}
+
+bool inputDouble(const char* label, double* v, double step, const char* fmt) {
+  return ImGui::InputDouble(label, v, step, step * 10, fmt);
+}
+
+bool combo(const char* label, std::string* value, const std::vector<const char*>& items) {
+  bool changed = false;
+  if (ImGui::BeginCombo(label, value->c_str())) {
+    for (const char* item : items)
+      if (ImGui::Selectable(item, *value == item)) {
+        *value = item;
+        changed = true;
+      }
+    ImGui::EndCombo();
+  }
+  return changed;
+}
+
+}  // namespace sailshape::viewer

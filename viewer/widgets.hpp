@@ -1,0 +1,42 @@
+#pragma once
+// What every panel of the window shares: its colours, the fixed-panel window,
+// number formatting and the few input widgets with the viewer's own rules.
+// Dear ImGui stays in the viewer's .cpp files and this header.
+#include <imgui.h>
+
+#include <string>
+#include <vector>
+
+#include "viewer/vtk_viewport.hpp"
+
+namespace sailshape::viewer {
+
+// The design's blue and the flying shape's red, as the 3D view draws them.
+constexpr ImU32 kDesignColour = IM_COL32(64, 140, 255, 255);
+constexpr ImU32 kFlyingColour = IM_COL32(220, 34, 26, 255);
+inline const ImVec4 kErrorText{1.0f, 0.45f, 0.40f, 1.0f};
+inline const ImVec4 kMutedText{0.62f, 0.66f, 0.72f, 1.0f};
+inline const ImVec4 kAccentText{1.0f, 0.80f, 0.25f, 1.0f};
+
+ImU32 toU32(const Rgb& c);
+ImVec4 toVec4(const Rgb& c);
+
+// `v` through printf's `fmt`; "—" when it is not finite.
+std::string format(const char* fmt, double v);
+// As format, with the sign always shown (`fmt` starts with '%').
+std::string signedFormat(const char* fmt, double v);
+
+// A panel at a fixed place and size in the window (pixels): it cannot be moved,
+// resized or collapsed. Call ImGui::End() whatever it returns.
+bool beginPanel(const char* name, float x, float y, float w, float h, ImGuiWindowFlags extra = 0);
+
+// A "(?)" after the last item that shows `text` when hovered.
+void helpMarker(const char* text);
+// An integer field whose value is kept within [lo, hi].
+bool inputInt(const char* label, int* v, int lo, int hi);
+// A number field stepping by `step` (by 10 steps with Ctrl).
+bool inputDouble(const char* label, double* v, double step, const char* fmt);
+// A drop-down of `items` writing the chosen one into `value`.
+bool combo(const char* label, std::string* value, const std::vector<const char*>& items);
+
+}  // namespace sailshape::viewer
