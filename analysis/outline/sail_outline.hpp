@@ -51,7 +51,7 @@ struct SailOutline {
   Vec3 tack = Vec3::Zero(), clew = Vec3::Zero(), head = Vec3::Zero(), peak = Vec3::Zero();
   bool has_peak = false;              // square-top sail: head (luff side) and peak (leech side)
   std::vector<double> corner_turn_deg;  // turning angle at tack, clew, head (, peak), outwards (> 0)
-  // Edge polylines, smoothed, from corner to corner: luff tack→head, leech
+  // Edge polylines (the fitted edge curves) from corner to corner: luff tack→head, leech
   // clew→head (clew→peak with a peak), foot tack→clew, top head→peak.
   std::vector<Vec3> luff, leech, foot, top;
   double luff_length_m = 0, leech_length_m = 0, foot_length_m = 0, top_length_m = 0;
