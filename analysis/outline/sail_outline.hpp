@@ -16,7 +16,6 @@ struct OutlineParams {
   double corner_window_m = 0.0;       // arm length for the turning angle; 0: 1 % of the boundary length
   // auto: a 4th corner turns at least this over twice the corner window, and half of it over the window
   double min_fourth_corner_deg = 40;
-  double edge_smoothing_m = 0.0;      // moving-average window along the edges; 0: 0.6 % of boundary length
   // Design lengths [luff, leech, foot] in metres to check against (empty: no check);
   // more than design_tolerance off stops the analysis (SPEC §4 step 6); more than
   // design_warning off, and beyond 3σ of the measured length, is a warning: a flying
