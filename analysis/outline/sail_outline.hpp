@@ -16,7 +16,6 @@ struct OutlineParams {
   double corner_window_m = 0.0;       // arm length for the turning angle; 0: 1 % of the boundary length
   // auto: a 4th corner turns at least this over twice the corner window, and half of it over the window
   double min_fourth_corner_deg = 40;
-  double edge_smoothing_m = 0.0;      // moving-average window along the edges; 0: 0.6 % of boundary length
   // Design lengths [luff, leech, foot] in metres to check against (empty: no check);
   // more than design_tolerance off stops the analysis (SPEC §4 step 6); more than
   // design_warning off, and beyond 3σ of the measured length, is a warning: a flying
@@ -51,7 +50,7 @@ struct SailOutline {
   Vec3 tack = Vec3::Zero(), clew = Vec3::Zero(), head = Vec3::Zero(), peak = Vec3::Zero();
   bool has_peak = false;              // square-top sail: head (luff side) and peak (leech side)
   std::vector<double> corner_turn_deg;  // turning angle at tack, clew, head (, peak), outwards (> 0)
-  // Edge polylines, smoothed, from corner to corner: luff tack→head, leech
+  // Edge polylines (the fitted edge curves) from corner to corner: luff tack→head, leech
   // clew→head (clew→peak with a peak), foot tack→clew, top head→peak.
   std::vector<Vec3> luff, leech, foot, top;
   double luff_length_m = 0, leech_length_m = 0, foot_length_m = 0, top_length_m = 0;

@@ -27,7 +27,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SmoothingParams, k_neighbours, r
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SurfaceParams, projection, max_edge_m, max_edge_factor,
                                                 largest_component_only)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(OutlineParams, corners, corner_window_m, min_fourth_corner_deg,
-                                                edge_smoothing_m, design_lengths_m, design_tolerance, design_warning,
+                                                design_lengths_m, design_tolerance, design_warning,
                                                 beam_exit_diameter_m, beam_divergence_rad, edges_against_sky)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions, plane, end_window, peak_window,
                                                 normal_tolerance_deg, max_tilt_deg, max_iterations, normal_radius,

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/fit.hpp"
 #include "analysis/core/units.hpp"
 
 namespace sailshape {
@@ -129,19 +130,16 @@ std::vector<Cut> cutMesh(const Mesh& mesh, const std::vector<Vec3>& normals, con
   return cuts;
 }
 
-// Least-squares polynomial of `degree` through xy, in u = (x - x0) / scale;
-// coefficients by rising power.
-Eigen::VectorXd fitPolynomial(const std::vector<Eigen::Vector2d>& xy, double x0, double scale, int degree) {
-  Eigen::MatrixXd A(static_cast<Eigen::Index>(xy.size()), degree + 1);
+// Least-squares polynomial of `degree` through the points xy (y over x), in
+// u = (x - x0) / scale; coefficients by rising power.
+Eigen::VectorXd polynomialThrough(const std::vector<Eigen::Vector2d>& xy, double x0, double scale, int degree) {
+  std::vector<double> x(xy.size());
   Eigen::VectorXd y(static_cast<Eigen::Index>(xy.size()));
   for (size_t i = 0; i < xy.size(); ++i) {
-    const auto r = static_cast<Eigen::Index>(i);
-    const double u = (xy[i].x() - x0) / scale;
-    double power = 1;
-    for (int k = 0; k <= degree; ++k, power *= u) A(r, k) = power;
-    y[r] = xy[i].y();
+    x[i] = xy[i].x();
+    y[static_cast<Eigen::Index>(i)] = xy[i].y();
   }
-  return A.colPivHouseholderQr().solve(y);
+  return fitPolynomial(x, y, degree, x0, scale).coeffs.col(0);
 }
 
 // Slope at x_end of a least-squares line (2 or 3 points) or quadratic (more)
@@ -152,7 +150,7 @@ double sideSlope(const std::vector<Eigen::Vector2d>& xy, double x_end, double wi
     if (left ? (v.x() <= x_end && v.x() >= x_end - window) : (v.x() >= x_end && v.x() <= x_end + window))
       win.push_back(v);
   if (win.size() < 2) return 0;
-  return fitPolynomial(win, x_end, 1.0, win.size() >= 4 ? 2 : 1)[1];
+  return polynomialThrough(win, x_end, 1.0, win.size() >= 4 ? 2 : 1)[1];
 }
 
 // The curve across the gap between the chord-coordinate samples xy[i] and
@@ -170,7 +168,7 @@ Bridge bridgeGap(const std::vector<Eigen::Vector2d>& xy, size_t i, double chord,
   for (const auto& v : xy)
     if ((v.x() <= xa && v.x() >= xa - window) || (v.x() >= xb && v.x() <= xb + window)) both.push_back(v);
   const bool checked = both.size() >= 3;
-  const Eigen::VectorXd q = checked ? fitPolynomial(both, xa, gap, 2) : Eigen::VectorXd::Zero(3);
+  const Eigen::VectorXd q = checked ? polynomialThrough(both, xa, gap, 2) : Eigen::VectorXd::Zero(3);
   Bridge bridge{xa, xb, 0};
   const int n = std::max(2, static_cast<int>(std::ceil(gap / step)));
   for (int k = 1; k < n; ++k) {

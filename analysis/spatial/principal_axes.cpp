@@ -1,9 +1,10 @@
 #include "analysis/spatial/principal_axes.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+
+#include "analysis/core/fit.hpp"
 
 namespace sailshape {
 namespace {
@@ -42,20 +43,18 @@ HeightFieldSpread quadraticHeightFieldSpread(const std::vector<Vec3>& points, co
   // conditioned; the residual does not depend on that scale.
   const double s = 1.0 / std::max(1e-12, std::sqrt(pa.variance[2]));
   const Vec3 eu = s * pa.axes.col(2), ev = s * pa.axes.col(1), n = pa.axes.col(0);
-  Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
-  HeightFieldSpread out;
+  QuadraticHeightField field;
   for (uint32_t i : indices) {
     const Vec3 d = points[i] - pa.mean;
-    const double u = d.dot(eu), v = d.dot(ev), h = d.dot(n);
-    Eigen::Matrix<double, 6, 1> row;
-    row << 1, u, v, u * u, u * v, v * v;
-    ata.noalias() += row * row.transpose();
-    atb += h * row;
-    out.plane_ss_m2 += h * h;
+    field.add(d.dot(eu), d.dot(ev), d.dot(n));
   }
+  // Fewer than 6 points in general position leave the fit singular; its residual
+  // is still held within the plane's.
+  field.solve();
+  HeightFieldSpread out;
+  out.plane_ss_m2 = field.height_ss;
   out.points = indices.size();
-  out.residual_ss_m2 = std::clamp(out.plane_ss_m2 - ata.ldlt().solve(atb).dot(atb), 0.0, out.plane_ss_m2);
+  out.residual_ss_m2 = field.residualSumOfSquares();
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/fit.hpp"
 #include "analysis/spatial/neighbours.hpp"
 #include "analysis/spatial/principal_axes.hpp"
 
@@ -183,16 +184,8 @@ void fitQuadratic(LocalSurface& s, const Rows& r, const std::vector<double>& w) 
         Lanes{dx * s.normal.x() + dy * s.normal.y() + dz * s.normal.z(), 0});
     for (int i = 0; i < 21; ++i) M[i] += L[i][0];
   }
-  // Basis 1, u, v, u², uv, v²: entry (i, j) is the moment of basis_i · basis_j.
-  const int idx[6][6] = {{0, 1, 2, 3, 4, 5},   {1, 3, 4, 6, 7, 8},    {2, 4, 5, 7, 8, 9},
-                         {3, 6, 7, 10, 11, 12}, {4, 7, 8, 11, 12, 13}, {5, 8, 9, 12, 13, 14}};
-  Eigen::Matrix<double, 6, 6> A;
-  for (int i = 0; i < 6; ++i)
-    for (int c = 0; c < 6; ++c) A(i, c) = M[idx[i][c]];
-  const Eigen::Matrix<double, 6, 1> b = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(M + 15);
-  Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(A);
-  const Eigen::Matrix<double, 6, 1> c = ldlt.solve(b);
-  if (ldlt.info() == Eigen::Success && c.allFinite()) s.c = c;
+  QuadraticHeightField field = QuadraticHeightField::fromMoments(M, M + 15);
+  if (field.solve()) s.c = field.coeffs;
 }
 
 // Anchored MLS: an anchor whose neighbours' centroid lies within this many radii
