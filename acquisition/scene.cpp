@@ -16,7 +16,7 @@ namespace {
 
 using nlohmann::json;
 
-// A hull as a prism: the deck outline (square stern, pointed bow) at deck_z,
+// A hull as a prism (TunnelHull): the deck outline (square stern, pointed bow) at deck_z,
 // the same outline narrowed at the keel line keel_z.
 Mesh makeHull(double stern_x, double bow_x, double half_beam, double deck_z, double keel_z) {
   const double shoulder = stern_x + 0.6 * (bow_x - stern_x);
