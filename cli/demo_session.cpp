@@ -211,8 +211,8 @@ struct EmulatedUnit {
 };
 
 // The region of interest a crew draws around each sail (study §5.4): the designed
-// sail's bounding box grown by `margin_m`, less what lies below the deck at `deck_z_m` and a clearance of
-// `clearance_m` around the spars, whose points region growing cannot always tell
+// sail's bounding box grown by `margin_m`, less what lies within `clearance_m` above the
+// deck (at `deck_z_m`) or around the spars, whose points region growing cannot always tell
 // from the sail where the luff and foot touch them at model scale, and forward of
 // `max_x_m` (a mainsail's box ends at the mast: beyond it lie the mast's mixed
 // pixels and the headsail).
