@@ -14,7 +14,7 @@ namespace sailshape {
 namespace {
 
 // Nuisance state of one target. Planes: normal n, offset d (n·x = d). Cylinders: axis point c and unit
-// direction a (c kept as the point of the axis nearest the centroid).
+// direction n (c kept as the point of the axis nearest the centroid).
 struct Shape {
   Vec3 n = Vec3::UnitZ();
   double d = 0;
@@ -43,7 +43,8 @@ Shape initialShape(const CalibrationTarget& t, const std::vector<Vec3>& pts) {
     s.d = s.n.dot(mean);
   } else {
     s.n = pa.axes.col(2);
-    // The scanner sees the near side: the axis lies one radius behind the centroid, away from the origin.
+    // The scanner sees the near side: the axis lies behind the centroid, away from the origin (the centroid
+    // of a half cylinder's surface lies 2/π of the radius from its axis).
     Vec3 away = mean - s.n * s.n.dot(mean);
     if (away.norm() < 1e-9) away = s.n.unitOrthogonal();
     s.c = mean + t.radius_m * 0.7 * away.normalized();
@@ -70,9 +71,7 @@ void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   t2 = n.cross(t1);
 }
 
-}  // namespace
-
-CalibrationResult calibrateUnit(const std::vector<CalibrationTarget>& targets, const CalibrationParams& params) {
+void validateTargets(const std::vector<CalibrationTarget>& targets, const CalibrationParams& params) {
   if (targets.empty()) throw InvalidInput("[calibrateUnit] no target given");
   if (!(params.initial_p_m > 0))
     throw InvalidInput("[calibrateUnit] initial_p_m must be > 0 (got " + std::to_string(params.initial_p_m) +
@@ -85,175 +84,216 @@ CalibrationResult calibrateUnit(const std::vector<CalibrationTarget>& targets, c
       throw InvalidInput("[calibrateUnit] cylinder target " + std::to_string(k) + " needs a radius > 0 (got " +
                          std::to_string(targets[k].radius_m) + ")");
   }
+}
+
+// The least-squares state. Parameters: p, θ, then per target 3 (plane: two normal tilts and the offset)
+// or 4 (cylinder: two axis tilts and two axis shifts).
+struct Fit {
+  explicit Fit(const std::vector<CalibrationTarget>& t) : targets(t) {}
+  const std::vector<CalibrationTarget>& targets;
+  std::vector<size_t> first;              // each target's first parameter
+  size_t np = 2;                          // parameters in all
+  std::vector<std::vector<char>> inlier;  // per target and sample: counted in the cost
+  double p = 0, theta = 0;
+  std::vector<Shape> shapes;
+  Eigen::MatrixXd JtJ;  // normal equations at the last linearisation
+  Eigen::VectorXd Jtr;
+};
+
+Fit initialFit(const std::vector<CalibrationTarget>& targets, const CalibrationParams& params) {
   const size_t nt = targets.size();
-  // Parameters: p, θ, then per target 3 (plane: two normal tilts and the offset) or 4 (cylinder: two axis
-  // tilts and two axis shifts).
-  std::vector<size_t> first(nt);
-  size_t np = 2;
+  Fit f(targets);
+  f.first.resize(nt);
   for (size_t k = 0; k < nt; ++k) {
-    first[k] = np;
-    np += targets[k].kind == CalibrationTarget::Kind::Plane ? 3 : 4;
+    f.first[k] = f.np;
+    f.np += targets[k].kind == CalibrationTarget::Kind::Plane ? 3 : 4;
   }
-  double p = params.initial_p_m, theta = params.initial_theta_rad;
-  std::vector<Shape> shapes(nt);
-  for (size_t k = 0; k < nt; ++k) shapes[k] = initialShape(targets[k], pointsOf(targets[k], p, theta));
-  std::vector<std::vector<char>> inlier(nt);
-  for (size_t k = 0; k < nt; ++k) inlier[k].assign(targets[k].samples.size(), 1);
+  f.p = params.initial_p_m;
+  f.theta = params.initial_theta_rad;
+  f.shapes.resize(nt);
+  for (size_t k = 0; k < nt; ++k) f.shapes[k] = initialShape(targets[k], pointsOf(targets[k], f.p, f.theta));
+  f.inlier.resize(nt);
+  for (size_t k = 0; k < nt; ++k) f.inlier[k].assign(targets[k].samples.size(), 1);
+  f.JtJ = Eigen::MatrixXd::Zero(f.np, f.np);
+  f.Jtr = Eigen::VectorXd::Zero(f.np);
+  return f;
+}
 
-  CalibrationResult result;
-  const auto cost = [&](double pp, double tt, const std::vector<Shape>& sh) {
-    double c = 0;
-    for (size_t k = 0; k < nt; ++k)
-      for (size_t i = 0; i < targets[k].samples.size(); ++i) {
-        if (!inlier[k][i]) continue;
-        const SweepPoint& s = targets[k].samples[i];
-        const double r = residual(targets[k], sh[k], unitPoint(s.range_m, s.alpha_rad, s.beta_rad, pp, tt), nullptr);
-        c += r * r;
-      }
-    return c;
-  };
+// Sum of squared residuals (m²) over the inliers at p = pp, θ = tt and shapes `sh`.
+double fitCost(const Fit& f, double pp, double tt, const std::vector<Shape>& sh) {
+  double c = 0;
+  for (size_t k = 0; k < f.targets.size(); ++k)
+    for (size_t i = 0; i < f.targets[k].samples.size(); ++i) {
+      if (!f.inlier[k][i]) continue;
+      const SweepPoint& s = f.targets[k].samples[i];
+      const double r = residual(f.targets[k], sh[k], unitPoint(s.range_m, s.alpha_rad, s.beta_rad, pp, tt), nullptr);
+      c += r * r;
+    }
+  return c;
+}
 
-  Eigen::MatrixXd JtJ(np, np);
-  Eigen::VectorXd Jtr(np);
-  for (int pass = 0; pass < 2; ++pass) {
-    double lambda = 1e-3;
-    double current = cost(p, theta, shapes);
-    bool converged = false;
-    for (int it = 0; it < params.max_iterations; ++it) {
-      ++result.iterations;
-      JtJ.setZero();
-      Jtr.setZero();
-      std::vector<Vec3> t1(nt), t2(nt);
-      for (size_t k = 0; k < nt; ++k) tangents(shapes[k].n, t1[k], t2[k]);
-      Eigen::VectorXd row(np);
-      for (size_t k = 0; k < nt; ++k) {
-        const bool plane = targets[k].kind == CalibrationTarget::Kind::Plane;
-        for (size_t i = 0; i < targets[k].samples.size(); ++i) {
-          if (!inlier[k][i]) continue;
-          const SweepPoint& s = targets[k].samples[i];
-          const Vec3 x = unitPoint(s.range_m, s.alpha_rad, s.beta_rad, p, theta);
-          Vec3 g;
-          const double r = residual(targets[k], shapes[k], x, &g);
-          row.setZero();
-          row(0) = g.dot(offsetDerivativeP(s.beta_rad, theta));
-          row(1) = g.dot(offsetDerivativeTheta(s.beta_rad, theta, p));
-          const size_t f = first[k];
-          if (plane) {
-            // n → normalize(n + a t1 + b t2), d → d + e.
-            row(f) = t1[k].dot(x);
-            row(f + 1) = t2[k].dot(x);
-            row(f + 2) = -1;
-          } else {
-            // Axis direction tilts (a, b) about the point c, axis shifts (e, h) along t1, t2.
-            const Vec3 v = x - shapes[k].c;
-            const double along = shapes[k].n.dot(v);
-            row(f) = -along * g.dot(t1[k]);
-            row(f + 1) = -along * g.dot(t2[k]);
-            row(f + 2) = -g.dot(t1[k]);
-            row(f + 3) = -g.dot(t2[k]);
-          }
-          JtJ.noalias() += row * row.transpose();
-          Jtr.noalias() += row * r;
-        }
+// JᵀJ and Jᵀr at the current state; t1, t2 span each shape's tilts.
+void linearise(Fit& f, const std::vector<Vec3>& t1, const std::vector<Vec3>& t2) {
+  f.JtJ.setZero();
+  f.Jtr.setZero();
+  Eigen::VectorXd row(f.np);
+  for (size_t k = 0; k < f.targets.size(); ++k) {
+    const CalibrationTarget& target = f.targets[k];
+    const bool plane = target.kind == CalibrationTarget::Kind::Plane;
+    for (size_t i = 0; i < target.samples.size(); ++i) {
+      if (!f.inlier[k][i]) continue;
+      const SweepPoint& s = target.samples[i];
+      const Vec3 x = unitPoint(s.range_m, s.alpha_rad, s.beta_rad, f.p, f.theta);
+      Vec3 g;
+      const double r = residual(target, f.shapes[k], x, &g);
+      row.setZero();
+      row(0) = g.dot(offsetDerivativeP(s.beta_rad, f.theta));
+      row(1) = g.dot(offsetDerivativeTheta(s.beta_rad, f.theta, f.p));
+      const size_t c = f.first[k];
+      if (plane) {
+        // n → normalize(n + a t1 + b t2), d → d + e.
+        row(c) = t1[k].dot(x);
+        row(c + 1) = t2[k].dot(x);
+        row(c + 2) = -1;
+      } else {
+        // Axis direction tilts (a, b) about the point c, axis shifts (e, h) along t1, t2.
+        const Vec3 v = x - f.shapes[k].c;
+        const double along = f.shapes[k].n.dot(v);
+        row(c) = -along * g.dot(t1[k]);
+        row(c + 1) = -along * g.dot(t2[k]);
+        row(c + 2) = -g.dot(t1[k]);
+        row(c + 3) = -g.dot(t2[k]);
       }
-      bool improved = false;
-      for (int tries = 0; tries < 12 && !improved; ++tries) {
-        Eigen::MatrixXd A = JtJ;
-        A.diagonal() += lambda * JtJ.diagonal().cwiseMax(1e-12);
-        const Eigen::VectorXd step = -A.ldlt().solve(Jtr);
-        const double p_new = p + step(0), theta_new = theta + step(1);
-        std::vector<Shape> trial = shapes;
-        for (size_t k = 0; k < nt; ++k) {
-          const size_t f = first[k];
-          Shape& s = trial[k];
-          if (targets[k].kind == CalibrationTarget::Kind::Plane) {
-            s.n = (s.n + step(f) * t1[k] + step(f + 1) * t2[k]).normalized();
-            s.d += step(f + 2);
-          } else {
-            s.n = (s.n + step(f) * t1[k] + step(f + 1) * t2[k]).normalized();
-            s.c += step(f + 2) * t1[k] + step(f + 3) * t2[k];
-          }
-        }
-        const double c = cost(p_new, theta_new, trial);
-        if (std::isfinite(c) && c <= current) {
-          const double change = current - c;
-          p = p_new;
-          theta = theta_new;
-          shapes = trial;
-          lambda = std::max(lambda / 3, 1e-9);
-          improved = true;
-          if (change <= 1e-12 * current || step.head<2>().norm() < 1e-10) converged = true;
-          current = c;
-        } else {
-          lambda *= 10;
-        }
-      }
-      if (!improved || converged) {
-        converged = converged || !improved;  // no step lowers the cost: at the minimum within precision
-        break;
+      f.JtJ.noalias() += row * row.transpose();
+      f.Jtr.noalias() += row * r;
+    }
+  }
+}
+
+// The shapes moved by the step's nuisance parameters.
+std::vector<Shape> steppedShapes(const Fit& f, const Eigen::VectorXd& step, const std::vector<Vec3>& t1,
+                                 const std::vector<Vec3>& t2) {
+  std::vector<Shape> trial = f.shapes;
+  for (size_t k = 0; k < f.targets.size(); ++k) {
+    const size_t c = f.first[k];
+    Shape& s = trial[k];
+    if (f.targets[k].kind == CalibrationTarget::Kind::Plane) {
+      s.n = (s.n + step(c) * t1[k] + step(c + 1) * t2[k]).normalized();
+      s.d += step(c + 2);
+    } else {
+      s.n = (s.n + step(c) * t1[k] + step(c + 1) * t2[k]).normalized();
+      s.c += step(c + 2) * t1[k] + step(c + 3) * t2[k];
+    }
+  }
+  return trial;
+}
+
+// Gauss–Newton with Levenberg damping over the current inliers; whether it converged.
+bool solve(Fit& f, const CalibrationParams& params, int& iterations) {
+  const size_t nt = f.targets.size();
+  double lambda = 1e-3;
+  double current = fitCost(f, f.p, f.theta, f.shapes);
+  bool converged = false;
+  for (int it = 0; it < params.max_iterations; ++it) {
+    ++iterations;
+    std::vector<Vec3> t1(nt), t2(nt);
+    for (size_t k = 0; k < nt; ++k) tangents(f.shapes[k].n, t1[k], t2[k]);
+    linearise(f, t1, t2);
+    bool improved = false;
+    for (int tries = 0; tries < 12 && !improved; ++tries) {
+      Eigen::MatrixXd A = f.JtJ;
+      A.diagonal() += lambda * f.JtJ.diagonal().cwiseMax(1e-12);
+      const Eigen::VectorXd step = -A.ldlt().solve(f.Jtr);
+      const double p_new = f.p + step(0), theta_new = f.theta + step(1);
+      std::vector<Shape> trial = steppedShapes(f, step, t1, t2);
+      const double c = fitCost(f, p_new, theta_new, trial);
+      if (std::isfinite(c) && c <= current) {
+        const double change = current - c;
+        f.p = p_new;
+        f.theta = theta_new;
+        f.shapes = trial;
+        lambda = std::max(lambda / 3, 1e-9);
+        improved = true;
+        if (change <= 1e-12 * current || step.head<2>().norm() < 1e-10) converged = true;
+        current = c;
+      } else {
+        lambda *= 10;
       }
     }
-    result.converged = converged;
-    if (pass == 1) break;
-    // Robust σ from the median absolute residual; drop the far ones and fit again.
-    std::vector<double> abs_res;
-    for (size_t k = 0; k < nt; ++k)
-      for (const SweepPoint& s : targets[k].samples)
-        abs_res.push_back(std::abs(residual(targets[k], shapes[k], unitPoint(s.range_m, s.alpha_rad, s.beta_rad, p, theta), nullptr)));
-    std::nth_element(abs_res.begin(), abs_res.begin() + abs_res.size() / 2, abs_res.end());
-    const double cut = params.outlier_sigmas <= 0 ? std::numeric_limits<double>::infinity() : params.outlier_sigmas * 1.4826 * abs_res[abs_res.size() / 2];
-    const double cos_max = std::cos(params.max_incidence_deg * M_PI / 180);
-    for (size_t k = 0; k < nt; ++k)
-      for (size_t i = 0; i < targets[k].samples.size(); ++i) {
-        const SweepPoint& s = targets[k].samples[i];
-        Vec3 g;
-        const double r =
-            residual(targets[k], shapes[k], unitPoint(s.range_m, s.alpha_rad, s.beta_rad, p, theta), &g);
-        const Vec3 ray(std::cos(s.alpha_rad), std::sin(s.alpha_rad) * std::cos(s.beta_rad),
-                       std::sin(s.alpha_rad) * std::sin(s.beta_rad));
-        inlier[k][i] = std::abs(r) <= cut && std::abs(ray.dot(g)) >= cos_max;
-      }
+    if (!improved || converged) {
+      converged = converged || !improved;  // no step lowers the cost: at the minimum within precision
+      break;
+    }
   }
+  return converged;
+}
 
-  // Diagnostics.
+// Robust σ from the median absolute residual; samples beyond params.outlier_sigmas of it, or seen at
+// more than params.max_incidence_deg, leave the fit.
+void dropOutliers(Fit& f, const CalibrationParams& params) {
+  const size_t nt = f.targets.size();
+  std::vector<double> abs_res;
+  for (size_t k = 0; k < nt; ++k)
+    for (const SweepPoint& s : f.targets[k].samples)
+      abs_res.push_back(std::abs(
+          residual(f.targets[k], f.shapes[k], unitPoint(s.range_m, s.alpha_rad, s.beta_rad, f.p, f.theta), nullptr)));
+  std::nth_element(abs_res.begin(), abs_res.begin() + abs_res.size() / 2, abs_res.end());
+  const double cut = params.outlier_sigmas <= 0 ? std::numeric_limits<double>::infinity()
+                                                : params.outlier_sigmas * 1.4826 * abs_res[abs_res.size() / 2];
+  const double cos_max = std::cos(params.max_incidence_deg * M_PI / 180);
+  for (size_t k = 0; k < nt; ++k)
+    for (size_t i = 0; i < f.targets[k].samples.size(); ++i) {
+      const SweepPoint& s = f.targets[k].samples[i];
+      Vec3 g;
+      const double r =
+          residual(f.targets[k], f.shapes[k], unitPoint(s.range_m, s.alpha_rad, s.beta_rad, f.p, f.theta), &g);
+      const Vec3 ray(std::cos(s.alpha_rad), std::sin(s.alpha_rad) * std::cos(s.beta_rad),
+                     std::sin(s.alpha_rad) * std::sin(s.beta_rad));
+      f.inlier[k][i] = std::abs(r) <= cut && std::abs(ray.dot(g)) >= cos_max;
+    }
+}
+
+// Per-target residuals and shapes, p and θ in their positive form, standard errors and warnings.
+void reportFit(const Fit& f, CalibrationResult& result) {
   size_t used = 0;
   double total = 0;
-  for (size_t k = 0; k < nt; ++k) {
+  for (size_t k = 0; k < f.targets.size(); ++k) {
+    const CalibrationTarget& target = f.targets[k];
     CalibrationTargetResult tr;
-    tr.name = targets[k].name;
-    tr.points = targets[k].samples.size();
+    tr.name = target.name;
+    tr.points = target.samples.size();
     double sum = 0;
     size_t n = 0;
-    for (size_t i = 0; i < targets[k].samples.size(); ++i) {
-      if (!inlier[k][i]) {
+    for (size_t i = 0; i < target.samples.size(); ++i) {
+      if (!f.inlier[k][i]) {
         ++tr.outliers;
         continue;
       }
-      const SweepPoint& s = targets[k].samples[i];
-      const double r = residual(targets[k], shapes[k], unitPoint(s.range_m, s.alpha_rad, s.beta_rad, p, theta), nullptr);
+      const SweepPoint& s = target.samples[i];
+      const double r = residual(target, f.shapes[k], unitPoint(s.range_m, s.alpha_rad, s.beta_rad, f.p, f.theta), nullptr);
       sum += r * r;
       tr.max_abs_m = std::max(tr.max_abs_m, std::abs(r));
       ++n;
     }
     tr.rms_m = n ? std::sqrt(sum / n) : 0;
-    tr.normal = shapes[k].n;
-    tr.point = shapes[k].c;
-    tr.offset_m = shapes[k].d;
+    tr.normal = f.shapes[k].n;
+    tr.point = f.shapes[k].c;
+    tr.offset_m = f.shapes[k].d;
     total += sum;
     used += n;
     result.targets.push_back(tr);
   }
-  result.p_m = p;
-  result.theta_rad = std::remainder(theta, 2 * M_PI);
+  result.p_m = f.p;
+  result.theta_rad = std::remainder(f.theta, 2 * M_PI);
   result.rms_m = used ? std::sqrt(total / used) : 0;
-  if (p < 0) {
+  if (f.p < 0) {
     // (−p, θ + π) is the same geometry; report the positive form.
-    result.p_m = -p;
-    result.theta_rad = std::remainder(theta + M_PI, 2 * M_PI);
+    result.p_m = -f.p;
+    result.theta_rad = std::remainder(f.theta + M_PI, 2 * M_PI);
   }
-  const double dof = static_cast<double>(used) - static_cast<double>(np);
+  const double dof = static_cast<double>(used) - static_cast<double>(f.np);
   if (dof > 0) {
-    const Eigen::MatrixXd cov = JtJ.ldlt().solve(Eigen::MatrixXd::Identity(np, np)) * (total / dof);
+    const Eigen::MatrixXd cov = f.JtJ.ldlt().solve(Eigen::MatrixXd::Identity(f.np, f.np)) * (total / dof);
     result.p_stderr_m = std::sqrt(std::max(0.0, cov(0, 0)));
     result.theta_stderr_rad = std::sqrt(std::max(0.0, cov(1, 1)));
   }
@@ -261,6 +301,19 @@ CalibrationResult calibrateUnit(const std::vector<CalibrationTarget>& targets, c
   if (result.theta_stderr_rad > 0.5 * M_PI / 180)
     result.warnings.push_back("θ is poorly determined (±" + std::to_string(result.theta_stderr_rad * 180 / M_PI) +
                               "°): add a second plane at an angle to the first, or sweep a wider β range");
+}
+
+}  // namespace
+
+CalibrationResult calibrateUnit(const std::vector<CalibrationTarget>& targets, const CalibrationParams& params) {
+  validateTargets(targets, params);
+  Fit fit = initialFit(targets, params);
+  CalibrationResult result;
+  // Fit, drop the outliers, fit again.
+  result.converged = solve(fit, params, result.iterations);
+  dropOutliers(fit, params);
+  result.converged = solve(fit, params, result.iterations);
+  reportFit(fit, result);
   return result;
 }
 

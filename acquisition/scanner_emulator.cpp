@@ -275,167 +275,190 @@ std::string ScannerEmulator::scanPayload(bool binary, bool polled, Clock::time_p
   return encodeScanData(scan, dialect);
 }
 
-std::string ScannerEmulator::reply(const std::string& request, bool binary) {
-  Session& s = *session_;
-  const ColaDialect dialect = binary ? ColaDialect::kBinary : ColaDialect::kAscii;
-  const ColaTelegram t = splitColaTelegram(request);
-  const bool lms111 = params_.sensor.model == ScannerModel::Lms111;
-  const auto out = [&](const char* type, const ColaWriter& w) { return colaPayload(type, t.name, w.bytes()); };
-  const auto bare = [&](const char* type) { return std::string(type) + " " + t.name + " "; };
-  const auto fail = [&](uint16_t code) {
+struct ScannerEmulator::Request {
+  Request(const std::string& payload, bool binary_)
+      : binary(binary_),
+        dialect(binary_ ? ColaDialect::kBinary : ColaDialect::kAscii),
+        t(splitColaTelegram(payload)),
+        in(dialect, t.arguments, t.type + " " + t.name),
+        w(dialect) {}
+  std::string out(const char* type, const ColaWriter& writer) const { return colaPayload(type, t.name, writer.bytes()); }
+  std::string bare(const char* type) const { return std::string(type) + " " + t.name + " "; }
+  std::string fail(uint16_t code) const {
     return binary ? std::string("sFA") + ColaWriter(ColaDialect::kBinary).u16(code).bytes()
                   : "sFA " + std::to_string(code);
-  };
-  ColaReader in(dialect, t.arguments, t.type + " " + t.name);
-  ColaWriter w(dialect);
-
-  if (t.type == "sMN") {
-    if (t.name == "SetAccessMode") {
-      const uint8_t level = in.u8("user level");
-      const uint32_t hash = in.u32("password hash");
-      // SICK's documented hashes: 2 maintenance, 3 authorised client, 4 service.
-      const bool ok = !params_.refuse_login && ((level == 2 && hash == 0xB21ACE26u) ||
-                                                (level == 3 && hash == 0xF4724744u) ||
-                                                (level == 4 && hash == 0x81BE23AAu));
-      if (ok) s.access_level = level;
-      return out("sAN", w.u8(ok ? 1 : 0));
-    }
-    if (t.name == "Run") {
-      s.running = true;
-      return out("sAN", w.u8(1));
-    }
-    if (s.access_level < 2) return fail(kErrAccessDenied);
-    if (t.name == "LMCstartmeas") {
-      if (!s.measuring) {
-        s.stream_start = std::max(Clock::now(), ready_at_);  // a starting device streams nothing yet
-        s.next_scan = 0;
-      }
-      s.measuring = true;
-      return out("sAN", w.u8(0));
-    }
-    if (t.name == "LMCstopmeas") {
-      s.measuring = false;
-      return out("sAN", w.u8(0));
-    }
-    if (t.name == "mLMPsetscancfg") {
-      const uint32_t f = in.u32("scan frequency");
-      in.u16("sectors");
-      const uint32_t res = in.u32("angular resolution");
-      const int32_t start = in.i32("start angle");
-      const int32_t stop = in.i32("stop angle");
-      const ScannerSpec spec = sensor_.spec();
-      const bool f_ok = lms111 ? (f == 2500 || f == 5000)
-                               : (f == 2500 || f == 3500 || f == 5000 || f == 7500 || f == 10000);
-      const bool res_ok = lms111 ? (res == 2500 || res == 5000)
-                                 : (res == 1667 || res == 2500 || res == 3333 || res == 5000 || res == 6667 ||
-                                    res == 10000);
-      // Status: 0 no error, 1 frequency not supported, 2 resolution not supported, 3 both, 4 sector wrong.
-      uint8_t status = (f_ok ? 0 : 1) | (res_ok ? 0 : 2);
-      if (status == 0 && !(start >= spec.first_angle_deg * 10000 && stop <= spec.last_angle_deg * 10000 && start < stop))
-        status = 4;
-      if (status == 0) {
-        s.frequency = f;
-        s.resolution = res;
-        s.start = start;
-        s.stop = stop;
-      }
-      return out("sAN", w.u8(status).u32(s.frequency).u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
-    }
-    return fail(kErrUnknownName);
   }
+  bool binary;
+  ColaDialect dialect;
+  ColaTelegram t;
+  ColaReader in;  // the request's arguments
+  ColaWriter w;   // the reply's
+};
 
-  if (t.type == "sRN") {
-    if (t.name == "FirmwareVersion") return out("sRA", w.string(lms111 ? "V1.80.2  " : "V1.80    "));
-    if (t.name == "SCdevicestate") return out("sRA", w.u8(Clock::now() < ready_at_ ? 0 : 1));  // 0 busy, 1 ready
-    if (t.name == "ODoprh") return out("sRA", w.u32(lms111 ? 0x456 : 0x4ab));
-    if (t.name == "ODpwrc") return out("sRA", w.u32(lms111 ? 0x3f : 0x63));
-    if (t.name == "LocationName") return out("sRA", w.string(lms111 ? "not defined" : "SN 18110550"));
-    if (t.name == "DeviceIdent")
-      return out("sRA", w.string(lms111 ? "LMS11x" : "LMS5xx").string(lms111 ? "V1.80.2" : "V1.80"));
-    if (t.name == "SerialNumber")
-      return out("sRA", w.string(std::to_string(params_.serial_number ? params_.serial_number
-                                                 : lms111           ? 18090362u
-                                                                    : 18110550u)));
-    if (t.name == "LMPoutputRange") return out("sRA", w.u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
-    if (t.name == "LMPscancfg") return out("sRA", w.u32(s.frequency).u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
-    if (t.name == "LMDscandatacfg") {
-      if (!s.scandatacfg_args.empty()) return colaPayload("sRA", t.name, s.scandatacfg_args);
-      return out("sRA", w.u8(1).u8(0).u8(s.remission).u8(0).u8(0).u8(s.encoder ? 1 : 0).u8(0).u8(0).u8(0).u8(0)
-                            .u8(s.time_block).u16(1));
-    }
-    if (t.name == "LIDinputstate") {
-      for (uint8_t b : hexBytes(lms111 ? kInputState111 : kInputState511)) w.u8(b);
-      return out("sRA", w);
-    }
-    if (t.name.size() == 8 && t.name.rfind("field0", 0) == 0) {
-      const int index = std::atoi(t.name.c_str() + 5);
-      if (index >= 10) return out("sRA", w.u8(0));  // no field set with that number
-      std::vector<uint8_t> bytes = hexBytes(lms111 ? kFieldTemplate111 : kFieldTemplate511);
-      bytes.back() = static_cast<uint8_t>(index);
-      for (uint8_t b : bytes) w.u8(b);
-      return out("sRA", w);
-    }
-    if (t.name == "LMDscandata") {
-      const double period_s = 100.0 / s.frequency;
-      return scanPayload(binary, true, Clock::now() - std::chrono::microseconds(roundToInt(period_s * 1e6)));
-    }
-    return fail(kErrUnknownName);
+std::string ScannerEmulator::reply(const std::string& request, bool binary) {
+  Request r(request, binary);
+  if (r.t.type == "sMN") return replyMethod(r);
+  if (r.t.type == "sRN") return replyRead(r);
+  if (r.t.type == "sWN") return replyWrite(r);
+  if (r.t.type == "sEN") return replyEvent(r);
+  return r.fail(kErrUnknownName);
+}
+
+// sMN: log in, start and stop measuring, scan configuration.
+std::string ScannerEmulator::replyMethod(Request& r) {
+  Session& s = *session_;
+  const bool lms111 = params_.sensor.model == ScannerModel::Lms111;
+  if (r.t.name == "SetAccessMode") {
+    const uint8_t level = r.in.u8("user level");
+    const uint32_t hash = r.in.u32("password hash");
+    // SICK's documented hashes: 2 maintenance, 3 authorised client, 4 service.
+    const bool ok = !params_.refuse_login && ((level == 2 && hash == 0xB21ACE26u) ||
+                                              (level == 3 && hash == 0xF4724744u) ||
+                                              (level == 4 && hash == 0x81BE23AAu));
+    if (ok) s.access_level = level;
+    return r.out("sAN", r.w.u8(ok ? 1 : 0));
   }
-
-  if (t.type == "sWN") {
-    if (t.name == "EIHstCola") return bare("sWA");
-    if (s.access_level < 2) return fail(kErrAccessDenied);
-    if (t.name == "LMPoutputRange") {
-      in.u16("sectors");
-      const uint32_t res = in.u32("angular resolution");
-      const int32_t start = in.i32("start angle");
-      const int32_t stop = in.i32("stop angle");
-      const ScannerSpec spec = sensor_.spec();
-      if (res != s.resolution || !(start >= spec.first_angle_deg * 10000 && stop <= spec.last_angle_deg * 10000 &&
-                                   start < stop))
-        return fail(kErrBadArguments);
+  if (r.t.name == "Run") {
+    s.running = true;
+    return r.out("sAN", r.w.u8(1));
+  }
+  if (s.access_level < 2) return r.fail(kErrAccessDenied);
+  if (r.t.name == "LMCstartmeas") {
+    if (!s.measuring) {
+      s.stream_start = std::max(Clock::now(), ready_at_);  // a starting device streams nothing yet
+      s.next_scan = 0;
+    }
+    s.measuring = true;
+    return r.out("sAN", r.w.u8(0));
+  }
+  if (r.t.name == "LMCstopmeas") {
+    s.measuring = false;
+    return r.out("sAN", r.w.u8(0));
+  }
+  if (r.t.name == "mLMPsetscancfg") {
+    const uint32_t f = r.in.u32("scan frequency");
+    r.in.u16("sectors");
+    const uint32_t res = r.in.u32("angular resolution");
+    const int32_t start = r.in.i32("start angle");
+    const int32_t stop = r.in.i32("stop angle");
+    const ScannerSpec spec = sensor_.spec();
+    const bool f_ok = lms111 ? (f == 2500 || f == 5000)
+                             : (f == 2500 || f == 3500 || f == 5000 || f == 7500 || f == 10000);
+    const bool res_ok = lms111 ? (res == 2500 || res == 5000)
+                               : (res == 1667 || res == 2500 || res == 3333 || res == 5000 || res == 6667 ||
+                                  res == 10000);
+    // Status: 0 no error, 1 frequency not supported, 2 resolution not supported, 3 both, 4 sector wrong.
+    uint8_t status = (f_ok ? 0 : 1) | (res_ok ? 0 : 2);
+    if (status == 0 && !(start >= spec.first_angle_deg * 10000 && stop <= spec.last_angle_deg * 10000 && start < stop))
+      status = 4;
+    if (status == 0) {
+      s.frequency = f;
+      s.resolution = res;
       s.start = start;
       s.stop = stop;
-      return bare("sWA");
     }
-    if (t.name == "LMDscandatacfg") {
-      // Two-byte fields go as byte pairs ("1 0" in CoLa A), as SICK's driver writes them.
-      const uint8_t channel = in.u8("output channel");
-      in.u8("output channel (second byte)");
-      const uint8_t remission = in.u8("remission");
-      const uint8_t resolution = in.u8("remission resolution");
-      in.u8("unit");
-      const uint8_t encoder = in.u8("encoder");
-      in.u8("encoder (second byte)");
-      in.u8("position");
-      in.u8("device name");
-      in.u8("comment");
-      const uint8_t time = in.u8("time");
-      in.u16("output interval");
-      if (channel == 0 || resolution > 1) return fail(kErrBadArguments);
-      s.remission = remission != 0;
-      s.encoder = encoder != 0;
-      s.time_block = time != 0;
-      s.scandatacfg_args = t.arguments;
-      return bare("sWA");
-    }
-    return fail(kErrUnknownName);
+    return r.out("sAN", r.w.u8(status).u32(s.frequency).u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
   }
+  return r.fail(kErrUnknownName);
+}
 
-  if (t.type == "sEN") {
-    const uint8_t on = in.u8("enable");
-    if (t.name == "LMDscandata") {
-      if (on && !s.streaming) {
-        s.stream_start = std::max(Clock::now(), ready_at_);  // a starting device streams nothing yet
-        s.next_scan = 0;
-      }
-      s.streaming = on != 0;
-    } else if (t.name != "LFErec" && t.name != "LIDoutputstate" && t.name != "LIDinputstate") {
-      return fail(kErrUnknownName);
-    }
-    return out("sEA", w.u8(on));
+// sRN: device facts and configuration as the recorded devices answered, and a polled scan.
+std::string ScannerEmulator::replyRead(Request& r) {
+  Session& s = *session_;
+  const bool lms111 = params_.sensor.model == ScannerModel::Lms111;
+  if (r.t.name == "FirmwareVersion") return r.out("sRA", r.w.string(lms111 ? "V1.80.2  " : "V1.80    "));
+  if (r.t.name == "SCdevicestate") return r.out("sRA", r.w.u8(Clock::now() < ready_at_ ? 0 : 1));  // 0 busy, 1 ready
+  if (r.t.name == "ODoprh") return r.out("sRA", r.w.u32(lms111 ? 0x456 : 0x4ab));
+  if (r.t.name == "ODpwrc") return r.out("sRA", r.w.u32(lms111 ? 0x3f : 0x63));
+  if (r.t.name == "LocationName") return r.out("sRA", r.w.string(lms111 ? "not defined" : "SN 18110550"));
+  if (r.t.name == "DeviceIdent")
+    return r.out("sRA", r.w.string(lms111 ? "LMS11x" : "LMS5xx").string(lms111 ? "V1.80.2" : "V1.80"));
+  if (r.t.name == "SerialNumber")
+    return r.out("sRA", r.w.string(std::to_string(params_.serial_number ? params_.serial_number
+                                               : lms111           ? 18090362u
+                                                                  : 18110550u)));
+  if (r.t.name == "LMPoutputRange") return r.out("sRA", r.w.u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
+  if (r.t.name == "LMPscancfg") return r.out("sRA", r.w.u32(s.frequency).u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
+  if (r.t.name == "LMDscandatacfg") {
+    if (!s.scandatacfg_args.empty()) return colaPayload("sRA", r.t.name, s.scandatacfg_args);
+    return r.out("sRA", r.w.u8(1).u8(0).u8(s.remission).u8(0).u8(0).u8(s.encoder ? 1 : 0).u8(0).u8(0).u8(0).u8(0)
+                          .u8(s.time_block).u16(1));
   }
-  return fail(kErrUnknownName);
+  if (r.t.name == "LIDinputstate") {
+    for (uint8_t b : hexBytes(lms111 ? kInputState111 : kInputState511)) r.w.u8(b);
+    return r.out("sRA", r.w);
+  }
+  if (r.t.name.size() == 8 && r.t.name.rfind("field0", 0) == 0) {
+    const int index = std::atoi(r.t.name.c_str() + 5);
+    if (index >= 10) return r.out("sRA", r.w.u8(0));  // no field set with that number
+    std::vector<uint8_t> bytes = hexBytes(lms111 ? kFieldTemplate111 : kFieldTemplate511);
+    bytes.back() = static_cast<uint8_t>(index);
+    for (uint8_t b : bytes) r.w.u8(b);
+    return r.out("sRA", r.w);
+  }
+  if (r.t.name == "LMDscandata") {
+    const double period_s = 100.0 / s.frequency;
+    return scanPayload(r.binary, true, Clock::now() - std::chrono::microseconds(roundToInt(period_s * 1e6)));
+  }
+  return r.fail(kErrUnknownName);
+}
+
+// sWN: the CoLa dialect, output range and scan data contents.
+std::string ScannerEmulator::replyWrite(Request& r) {
+  Session& s = *session_;
+  if (r.t.name == "EIHstCola") return r.bare("sWA");
+  if (s.access_level < 2) return r.fail(kErrAccessDenied);
+  if (r.t.name == "LMPoutputRange") {
+    r.in.u16("sectors");
+    const uint32_t res = r.in.u32("angular resolution");
+    const int32_t start = r.in.i32("start angle");
+    const int32_t stop = r.in.i32("stop angle");
+    const ScannerSpec spec = sensor_.spec();
+    if (res != s.resolution || !(start >= spec.first_angle_deg * 10000 && stop <= spec.last_angle_deg * 10000 &&
+                                 start < stop))
+      return r.fail(kErrBadArguments);
+    s.start = start;
+    s.stop = stop;
+    return r.bare("sWA");
+  }
+  if (r.t.name == "LMDscandatacfg") {
+    // Two-byte fields go as byte pairs ("1 0" in CoLa A), as SICK's driver writes them.
+    const uint8_t channel = r.in.u8("output channel");
+    r.in.u8("output channel (second byte)");
+    const uint8_t remission = r.in.u8("remission");
+    const uint8_t resolution = r.in.u8("remission resolution");
+    r.in.u8("unit");
+    const uint8_t encoder = r.in.u8("encoder");
+    r.in.u8("encoder (second byte)");
+    r.in.u8("position");
+    r.in.u8("device name");
+    r.in.u8("comment");
+    const uint8_t time = r.in.u8("time");
+    r.in.u16("output interval");
+    if (channel == 0 || resolution > 1) return r.fail(kErrBadArguments);
+    s.remission = remission != 0;
+    s.encoder = encoder != 0;
+    s.time_block = time != 0;
+    s.scandatacfg_args = r.t.arguments;
+    return r.bare("sWA");
+  }
+  return r.fail(kErrUnknownName);
+}
+
+// sEN: subscriptions; only LMDscandata streams anything.
+std::string ScannerEmulator::replyEvent(Request& r) {
+  Session& s = *session_;
+  const uint8_t on = r.in.u8("enable");
+  if (r.t.name == "LMDscandata") {
+    if (on && !s.streaming) {
+      s.stream_start = std::max(Clock::now(), ready_at_);  // a starting device streams nothing yet
+      s.next_scan = 0;
+    }
+    s.streaming = on != 0;
+  } else if (r.t.name != "LFErec" && r.t.name != "LIDoutputstate" && r.t.name != "LIDinputstate") {
+    return r.fail(kErrUnknownName);
+  }
+  return r.out("sEA", r.w.u8(on));
 }
 
 }  // namespace sailshape

@@ -59,11 +59,17 @@ class ScannerEmulator {
   uint64_t connections() const { return connections_; }
 
   // The reply payloads (unframed) to one request payload in `binary` or ASCII; what a connection gets.
-  // Public so tests can check replies telegram by telegram. Empty when the request gets no reply.
+  // Public so tests can check replies telegram by telegram. An unknown request, or one that needs a login
+  // first, gets an sFA error reply.
   std::string reply(const std::string& request_payload, bool binary);
 
  private:
   struct Session;
+  struct Request;  // one request being answered: its telegram, argument reader and reply writer
+  std::string replyMethod(Request& r);  // sMN
+  std::string replyRead(Request& r);    // sRN
+  std::string replyWrite(Request& r);   // sWN
+  std::string replyEvent(Request& r);   // sEN
   void serve();
   void runSession(int fd);
   // One LMDscandata payload for the scan that began at scan_start (β per beam from the turntable).

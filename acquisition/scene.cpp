@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "acquisition/tunnel.hpp"
 #include "analysis/core/errors.hpp"
 #include "analysis/io/mesh_io.hpp"
 
@@ -15,7 +16,7 @@ namespace {
 
 using nlohmann::json;
 
-// A hull as a prism: the deck outline (square stern, pointed bow) at deck_z,
+// A hull as a prism (TunnelHull): the deck outline (square stern, pointed bow) at deck_z,
 // the same outline narrowed at the keel line keel_z.
 Mesh makeHull(double stern_x, double bow_x, double half_beam, double deck_z, double keel_z) {
   const double shoulder = stern_x + 0.6 * (bow_x - stern_x);
@@ -36,6 +37,10 @@ Mesh makeHull(double stern_x, double bow_x, double half_beam, double deck_z, dou
     m.triangles.push_back({u(i), u(n + j), u(j)});
   }
   return m;
+}
+
+SceneObject sparObject(const Spar& spar, int segments) {
+  return {spar.name, Material::Metal, makeCylinder(spar.base, spar.axis, spar.radius_m, spar.length_m, segments)};
 }
 
 SceneObject sailObject(const std::string& name, const SailDesign& design, int rows = 80, int columns = 40) {
@@ -207,19 +212,17 @@ std::vector<SceneObject> makeChamber(const Vec3& lo, const Vec3& hi) {
 }
 
 Scene builtInTunnelScene() {
-  // Model scale 1:3.6 of the example designs; the mast foot (deck level) is the
-  // origin and the tunnel floor lies 0.6 m below it.
-  constexpr double kScale = 1.0 / 3.6;
+  const TunnelDescription t = builtInTunnel();
   Scene s;
   s.name = "tunnel";
-  s.objects = makeChamber(Vec3(-8.0, -7.0, -0.6), Vec3(8.0, 7.0, 3.2));
-  s.objects.push_back({"hull", Material::Paint, makeHull(-1.3, 1.5, 0.42, 0.0, -0.6)});
-  s.objects.push_back({"mast", Material::Metal, makeCylinder(Vec3(0.035, 0, 0), Vec3::UnitZ(), 0.025, 3.05, 16)});
-  s.objects.push_back({"boom", Material::Metal,
-                       makeCylinder(Vec3(0.0, 0, 0.26), -Vec3::UnitX(), 0.015, 1.05, 12)});
-  SailDesign main = scaleDesign(exampleDesign(SailType::Main), kScale);
+  s.objects = makeChamber(t.chamber_min_m, t.chamber_max_m);
+  const TunnelHull& h = t.hull;
+  s.objects.push_back({"hull", Material::Paint, makeHull(h.stern_x_m, h.bow_x_m, h.half_beam_m, h.deck_z_m, h.keel_z_m)});
+  s.objects.push_back(sparObject(t.mast, t.mast_segments));
+  s.objects.push_back(sparObject(t.boom, t.boom_segments));
+  SailDesign main = scaleDesign(exampleDesign(SailType::Main), t.model_scale);
   s.objects.push_back(sailObject("main", main));
-  SailDesign gennaker = scaleDesign(exampleDesign(SailType::Gennaker), kScale);
+  SailDesign gennaker = scaleDesign(exampleDesign(SailType::Gennaker), t.model_scale);
   gennaker.stations = {{0.0, 20, 45, 32, 2.4, 1.8}, {0.5, 25, 48, 42, 2.4, 1.8}, {1.0, 17, 50, 56, 2, 2}};  // A2 running
   s.objects.push_back(sailObject("gennaker", gennaker));
   return s;

@@ -43,8 +43,8 @@ Mesh makeCylinder(const Vec3& base, const Vec3& axis, double radius_m, double le
 // Inside faces of an axis-aligned chamber: floor at min.z, ceiling at max.z, four walls.
 std::vector<SceneObject> makeChamber(const Vec3& min_corner, const Vec3& max_corner);
 
-// The built-in wind-tunnel scene: a 14 m × 3.8 m test section with a 1:4
-// yacht model (hull, deck, mast, boom), its mainsail and an A2 gennaker.
+// The built-in wind-tunnel scene, from builtInTunnel() (tunnel.hpp): the chamber, the
+// 1:3.6 yacht model's hull, mast and boom, its mainsail and an A2 gennaker.
 Scene builtInTunnelScene();
 // A full-scale boat deck with a 0.5 m reference cube, mast, boom, hull and a mainsail.
 Scene builtInDeckScene();

@@ -31,8 +31,8 @@ struct ScannerSpec {
 };
 ScannerSpec scannerSpec(ScannerModel model);
 
-struct OutlineParams;  // analysis/sail_outline.hpp
-struct Cloud;          // analysis/cloud.hpp
+struct OutlineParams;  // analysis/outline/sail_outline.hpp
+struct Cloud;          // analysis/core/cloud.hpp
 // The outline's beam settings for a cloud this model measured: its footprint
 // trims every edge (OutlineParams::beam_exit_diameter_m, beam_divergence_rad).
 void useScannerBeam(OutlineParams& outline, ScannerModel model);

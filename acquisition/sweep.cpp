@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <thread>
 
 #include "acquisition/scan_data.hpp"
@@ -98,16 +99,10 @@ void validateSweepOptions(const SweepOptions& o) {
   need(o.ready_timeout_s, "ready_timeout_s");
 }
 
-Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progress& progress) {
-  validateUnit(unit);
-  validateSweepOptions(options);
-  Sweep sweep;
-  sweep.unit = unit.name;
+namespace {
 
-  TurntableLinkParams link;
-  link.device = unit.serial_device;
-  link.baud = unit.baud;
-  TurntableClient table(link);
+// Homes the turntable (when asked) and moves it to the sweep's start angle at the positioning speed.
+void moveToStart(TurntableClient& table, const UnitConfig& unit, const SweepOptions& options, const Progress& progress) {
   table.setAcceleration(unit.acceleration_deg_s2);
   if (options.home) table.home(options.home_timeout_s, progress);
   table.setVelocity(options.positioning_speed_deg_s);
@@ -116,7 +111,10 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
   if (!table.waitIdle(positioning_s))
     throw TurntableError("[runSweep] " + unit.name + ": the turntable did not reach the start angle " +
                          std::to_string(unit.start_angle_deg) + "° within " + std::to_string(positioning_s) + " s");
+}
 
+// The unit file's scan settings in the device's units (1/100 Hz, 1/10000°).
+ScannerClientParams scannerParams(const UnitConfig& unit, const SweepOptions& options) {
   ScannerClientParams sp;
   sp.host = unit.host;
   sp.port = unit.port;
@@ -129,37 +127,59 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
   sp.stop_angle = static_cast<int32_t>(std::lround(unit.output_stop_deg * 10000));
   sp.rssi = unit.rssi;
   sp.capture_path = options.capture_path;
-  ScannerClient scanner(sp);
+  return sp;
+}
+
+// The scanner's start-up sequence, then the encoder block in every scan when β comes from the encoder.
+ScannerStartup startScanner(ScannerClient& scanner, const UnitConfig& unit, ColaDialect dialect, Sweep& sweep) {
   const ScannerStartup startup = scanner.start();
   for (const std::string& w : startup.warnings) sweep.warnings.push_back(w);
   if (unit.beta_source == BetaSource::Encoder) {
     // The turntable's encoder is wired to the scanner: ask for the encoder block in every scan
     // (LMDscandatacfg: channel, remission, 8-bit, mm, encoder 1, no position/name/comment/time, every scan).
-    ColaWriter w(sp.dialect);
+    ColaWriter w(dialect);
     w.u8(1).u8(0).u8(unit.rssi ? 1 : 0).u8(0).u8(0).u8(1).u8(0).u8(0).u8(0).u8(0).u8(0).u16(1);
     scanner.request("sWN", "LMDscandatacfg", w.bytes());
   }
+  return startup;
+}
 
-  // The move waits for the scans: a unit still spinning up streams nothing yet.
-  {
-    const double since = hostTimeSeconds(), deadline = since + options.ready_timeout_s;
-    for (;;) {
-      const double left = deadline - hostTimeSeconds();
-      if (left <= 0)
-        throw ScannerError("[runSweep] " + unit.name + ": the scanner streamed no scan within " +
-                           shortNumber(options.ready_timeout_s) +
-                           " s of its start-up (device state " + std::to_string(startup.device_state) +
-                           (startup.device_state == 0 ? ", busy" : "") + ")");
-      const ScanBatch first = scanner.receiveScans(1, left);
-      if (!first.scans.empty()) break;
-      if (first.connection_lost) throw ScannerError("[runSweep] " + unit.name + ": " + first.message);
-      progress("scanner starting", std::clamp((hostTimeSeconds() - since) / options.ready_timeout_s, 0.0, 1.0));
-    }
+// The move waits for the scans: a unit still spinning up streams nothing yet.
+void waitForFirstScan(ScannerClient& scanner, const UnitConfig& unit, const SweepOptions& options,
+                      const ScannerStartup& startup, const Progress& progress) {
+  const double since = hostTimeSeconds(), deadline = since + options.ready_timeout_s;
+  for (;;) {
+    const double left = deadline - hostTimeSeconds();
+    if (left <= 0)
+      throw ScannerError("[runSweep] " + unit.name + ": the scanner streamed no scan within " +
+                         shortNumber(options.ready_timeout_s) +
+                         " s of its start-up (device state " + std::to_string(startup.device_state) +
+                         (startup.device_state == 0 ? ", busy" : "") + ")");
+    const ScanBatch first = scanner.receiveScans(1, left);
+    if (!first.scans.empty()) break;
+    if (first.connection_lost) throw ScannerError("[runSweep] " + unit.name + ": " + first.message);
+    progress("scanner starting", std::clamp((hostTimeSeconds() - since) / options.ready_timeout_s, 0.0, 1.0));
   }
-  if (options.wait_for_start) sweep.trigger_time_s = options.wait_for_start();
+}
 
+// What streamed while the turntable turned through the sweep.
+struct Streamed {
   std::vector<ReceivedScan> scans;
-  std::vector<TableSample> table_samples;
+  std::vector<TableSample> table_samples;  // host time and β (degrees), polled during the move
+  // The scanner's clock on the host's, as the smallest receive − transmission gap over every scan received
+  // (seconds): a scan that arrives late (a busy network, or a device draining its output) is still placed
+  // at its own time.
+  double clock_offset_s = std::numeric_limits<double>::infinity();
+};
+
+// Commands the sweep move and keeps every scan until the turntable is idle, judged by each scan's own
+// start; a turntable fault, a scanner error or a move overrunning its time end the sweep as partial.
+// Stops the turntable (partial) and the scanner's stream either way.
+Streamed streamSweep(TurntableClient& table, ScannerClient& scanner, const UnitConfig& unit,
+                     const SweepOptions& options, Sweep& sweep, const Progress& progress) {
+  Streamed out;
+  std::vector<ReceivedScan>& scans = out.scans;
+  std::vector<TableSample>& table_samples = out.table_samples;
   const double target = unit.start_angle_deg + unit.sweep_angle_deg;
   table.setVelocity(unit.speed_deg_s);
   table_samples.push_back({hostTimeSeconds(), table.sample().deg()});
@@ -169,9 +189,6 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
                             unit.speed_deg_s / unit.acceleration_deg_s2 + 2.0;
   double last_poll = 0;
   double idle_at = -1;
-  // The scanner's clock on the host's, as the smallest receive − transmission gap so far: a scan that
-  // arrives late (a busy network, or a device draining its output) is still placed at its own time.
-  double running_offset = std::numeric_limits<double>::infinity();
   for (;;) {
     const double now = hostTimeSeconds();
     if (now - last_poll > 0.015 || idle_at < 0) {
@@ -189,7 +206,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     }
     // One more scan after the table stopped so the last moving scan has a successor for β interpolation.
     if (idle_at > 0 && !scans.empty() &&
-        scans.back().data.time_since_startup_us * 1e-6 + running_offset > idle_at + 0.5 / unit.frequency_hz)
+        scans.back().data.time_since_startup_us * 1e-6 + out.clock_offset_s > idle_at + 0.5 / unit.frequency_hz)
       break;
     if (now - sweep.start_time_s > expected_s + options.scan_timeout_s) {
       sweep.partial = true;
@@ -200,7 +217,8 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
       ScanData s = scanner.nextScan();
       if (options.on_scan) options.on_scan(previewPoints(unit, s, table_samples.back().deg));
       scans.push_back({std::move(s), hostTimeSeconds()});
-      running_offset = std::min(running_offset, scans.back().host_time_s - scans.back().data.time_of_transmission_us * 1e-6);
+      out.clock_offset_s =
+          std::min(out.clock_offset_s, scans.back().host_time_s - scans.back().data.time_of_transmission_us * 1e-6);
     } catch (const ScannerError& e) {
       sweep.partial = true;
       sweep.message = e.what();
@@ -221,20 +239,61 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     sweep.warnings.push_back(std::string("stop sequence: ") + e.what());
   }
   table_samples.push_back({hostTimeSeconds(), table.sample().deg()});
+  return out;
+}
 
-  // Scans taken before the move was commanded stand at the start angle: not part of the sweep.
-  // Timestamp mode maps the scanner's clock to the host's by the smallest receive − transmission gap.
-  const double clock_offset = running_offset;  // over every scan received
-  const bool encoder = unit.beta_source == BetaSource::Encoder;
-  size_t used = 0;
-  // Each used scan's counter and β at its middle beam: where the lost lines lay.
-  std::vector<std::pair<uint16_t, double>> line_beta_deg;
-  // Scans the device counted but never delivered: gaps in the scan counter between received scans.
+// Scans the device counted but never delivered: gaps in the scan counter between received scans of the sweep.
+size_t countMissedScans(const Streamed& streamed, double sweep_start_s) {
+  const std::vector<ReceivedScan>& scans = streamed.scans;
+  size_t missed = 0;
   for (size_t k = 1; k < scans.size(); ++k) {
     const uint16_t step = static_cast<uint16_t>(scans[k].data.scan_counter - scans[k - 1].data.scan_counter);
-    if (step > 1 && scans[k].data.time_since_startup_us * 1e-6 + clock_offset >= sweep.start_time_s)
-      sweep.scans_missed += step - 1u;
+    if (step > 1 && scans[k].data.time_since_startup_us * 1e-6 + streamed.clock_offset_s >= sweep_start_s)
+      missed += step - 1u;
   }
+  return missed;
+}
+
+// β(u) = beta0 + rate·u + curve·u² (degrees), u in scan periods from a scan's first beam.
+struct EncoderBeta {
+  double beta0 = 0, rate = 0, curve = 0;
+};
+
+// The encoder is latched once per scan; between readings the turntable may accelerate, so β per beam
+// follows the parabola through the previous, this and the next reading (a line at the ends).
+// Scan k must carry an encoder block.
+EncoderBeta encoderBeta(const std::vector<ReceivedScan>& scans, size_t k) {
+  const ScanData& s = scans[k].data;
+  EncoderBeta b;
+  b.beta0 = encoderDeg(s);
+  const auto usable = [&](size_t j) { return j < scans.size() && !scans[j].data.encoders.empty(); };
+  const double h_next = usable(k + 1) ? static_cast<uint16_t>(scans[k + 1].data.scan_counter - s.scan_counter) : 0;
+  const double h_prev = k > 0 && usable(k - 1) ? static_cast<uint16_t>(s.scan_counter - scans[k - 1].data.scan_counter) : 0;
+  const double d_next = h_next > 0 ? encoderDeg(scans[k + 1].data) - b.beta0 : 0;
+  const double d_prev = h_prev > 0 ? b.beta0 - encoderDeg(scans[k - 1].data) : 0;
+  if (h_next > 0 && h_prev > 0) {
+    const double s_next = d_next / h_next, s_prev = d_prev / h_prev;
+    b.curve = (s_next - s_prev) / (h_next + h_prev);
+    b.rate = s_next - b.curve * h_next;
+  } else if (h_next > 0) {
+    b.rate = d_next / h_next;
+  } else if (h_prev > 0) {
+    b.rate = d_prev / h_prev;
+  }
+  return b;
+}
+
+// Every echo of the scans taken during the move, with β per beam; returns each used scan's counter and
+// β at its middle beam (degrees), where the lost lines lay. Scans taken before the move was commanded
+// stand at the start angle: not part of the sweep. Timestamp mode maps the scanner's clock to the host's
+// by the smallest receive − transmission gap.
+std::vector<std::pair<uint16_t, double>> assemblePoints(const Streamed& streamed, const UnitConfig& unit,
+                                                        Sweep& sweep) {
+  const std::vector<ReceivedScan>& scans = streamed.scans;
+  const double clock_offset = streamed.clock_offset_s;
+  const bool encoder = unit.beta_source == BetaSource::Encoder;
+  size_t used = 0;
+  std::vector<std::pair<uint16_t, double>> line_beta_deg;
   for (size_t k = 0; k < scans.size(); ++k) {
     const ScanData& s = scans[k].data;
     const ScanChannel* dist = s.channel("DIST1");
@@ -246,8 +305,7 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     const double period_s = s.scan_frequency > 0 ? 100.0 / s.scan_frequency : 1.0 / unit.frequency_hz;
     const double scan_host_start = s.time_since_startup_us * 1e-6 + clock_offset;
     if (scan_host_start < sweep.start_time_s - period_s) continue;
-    // β(u) = beta0 + beta_rate·u + beta_curve·u², u in scan periods from this scan's first beam.
-    double beta0 = 0, beta_rate = 0, beta_curve = 0;
+    EncoderBeta eb;
     if (encoder) {
       if (s.encoders.empty()) {
         // Scans streamed before the encoder block was switched on are expected; later ones are not.
@@ -256,31 +314,15 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
                                    " has no encoder block although beta_source is encoder: skipped");
         continue;
       }
-      beta0 = encoderDeg(s);
-      // The encoder is latched once per scan; between readings the turntable may accelerate, so β per beam
-      // follows the parabola through the previous, this and the next reading (a line at the ends).
-      const auto usable = [&](size_t j) { return j < scans.size() && !scans[j].data.encoders.empty(); };
-      const double h_next = usable(k + 1) ? static_cast<uint16_t>(scans[k + 1].data.scan_counter - s.scan_counter) : 0;
-      const double h_prev = k > 0 && usable(k - 1) ? static_cast<uint16_t>(s.scan_counter - scans[k - 1].data.scan_counter) : 0;
-      const double d_next = h_next > 0 ? encoderDeg(scans[k + 1].data) - beta0 : 0;
-      const double d_prev = h_prev > 0 ? beta0 - encoderDeg(scans[k - 1].data) : 0;
-      if (h_next > 0 && h_prev > 0) {
-        const double s_next = d_next / h_next, s_prev = d_prev / h_prev;
-        beta_curve = (s_next - s_prev) / (h_next + h_prev);
-        beta_rate = s_next - beta_curve * h_next;
-      } else if (h_next > 0) {
-        beta_rate = d_next / h_next;
-      } else if (h_prev > 0) {
-        beta_rate = d_prev / h_prev;
-      }
+      eb = encoderBeta(scans, k);
     }
     ++used;
     sweep.beams += dist->values.size();
     const double first_alpha_deg = scanAngleDeg(*dist, 0);
     // β (deg) at `frac` of a mirror turn from this scan's first beam.
     auto betaAt = [&](double frac) {
-      return encoder ? beta0 + frac * (beta_rate + frac * beta_curve)
-                     : interpolateBeta(table_samples, scan_host_start + frac * period_s);
+      return encoder ? eb.beta0 + frac * (eb.rate + frac * eb.curve)
+                     : interpolateBeta(streamed.table_samples, scan_host_start + frac * period_s);
     };
     line_beta_deg.emplace_back(s.scan_counter,
                                betaAt(0.5 * (scanAngleDeg(*dist, dist->values.size() - 1) - first_alpha_deg) / 360.0));
@@ -297,14 +339,11 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     }
   }
   sweep.scans = used;
-  if (sweep.scans_missed > 0)
-    sweep.warnings.push_back(std::to_string(sweep.scans_missed) + " of " + std::to_string(used + sweep.scans_missed) +
-                             " scans of the sweep never arrived (gaps in the scan counter): the scan lines are "
-                             "that much further apart there");
-  if (!sweep.points.empty()) {
-    sweep.beta_start_deg = sweep.points.front().beta_rad / kRadPerDeg;
-    sweep.beta_end_deg = sweep.points.back().beta_rad / kRadPerDeg;
-  }
+  return line_beta_deg;
+}
+
+// The sweep's cloud from its points (SPEC §2 and the unit's pose), with the lost lines' β.
+void buildCloud(const UnitConfig& unit, const std::vector<std::pair<uint16_t, double>>& line_beta_deg, Sweep& sweep) {
   sweep.cloud.viewpoint = unit.pose.translation();
   sweep.cloud.lost_beta_rad = lostLineBetas(line_beta_deg);
   sweep.cloud.points.reserve(sweep.points.size());
@@ -314,7 +353,42 @@ Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progre
     sweep.cloud.beta_rad.push_back(p.beta_rad);
     sweep.cloud.intensity.push_back(p.rssi);
   }
-  if (!sweep.partial && used == 0) {
+}
+
+}  // namespace
+
+Sweep runSweep(const UnitConfig& unit, const SweepOptions& options, const Progress& progress) {
+  validateUnit(unit);
+  validateSweepOptions(options);
+  Sweep sweep;
+  sweep.unit = unit.name;
+
+  TurntableLinkParams link;
+  link.device = unit.serial_device;
+  link.baud = unit.baud;
+  TurntableClient table(link);
+  moveToStart(table, unit, options, progress);
+
+  const ScannerClientParams sp = scannerParams(unit, options);
+  ScannerClient scanner(sp);
+  const ScannerStartup startup = startScanner(scanner, unit, sp.dialect, sweep);
+  waitForFirstScan(scanner, unit, options, startup, progress);
+  if (options.wait_for_start) sweep.trigger_time_s = options.wait_for_start();
+
+  const Streamed streamed = streamSweep(table, scanner, unit, options, sweep, progress);
+  sweep.scans_missed = countMissedScans(streamed, sweep.start_time_s);
+  const std::vector<std::pair<uint16_t, double>> line_beta_deg = assemblePoints(streamed, unit, sweep);
+  if (sweep.scans_missed > 0)
+    sweep.warnings.push_back(std::to_string(sweep.scans_missed) + " of " +
+                             std::to_string(sweep.scans + sweep.scans_missed) +
+                             " scans of the sweep never arrived (gaps in the scan counter): the scan lines are "
+                             "that much further apart there");
+  if (!sweep.points.empty()) {
+    sweep.beta_start_deg = sweep.points.front().beta_rad / kRadPerDeg;
+    sweep.beta_end_deg = sweep.points.back().beta_rad / kRadPerDeg;
+  }
+  buildCloud(unit, line_beta_deg, sweep);
+  if (!sweep.partial && sweep.scans == 0) {
     sweep.partial = true;
     sweep.message = "no scan arrived while the turntable moved";
   }

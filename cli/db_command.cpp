@@ -212,6 +212,95 @@ void addQueryOptions(CLI::App* cmd, DbOptions& o) {
   compare->excludes(best);
 }
 
+// `db import`'s options: the file, and the campaign, session, sail, test and conditions it belongs to.
+void addImportOptions(CLI::App* imp, DbOptions& o) {
+  imp->add_option("FILE", o.file, "Analysis JSON (.json) or cloud (.ply, .pcd, .xyz, .txt, .csv)")->required()->check(CLI::ExistingFile);
+  imp->add_option("--cloud", o.cloud_file, "With an analysis JSON FILE: also store this cloud (compressed)")->check(CLI::ExistingFile);
+  imp->add_option("--campaign", o.meta.campaign, "Campaign name, created when new (default \"default\")");
+  imp->add_option("--campaign-kind", o.meta.campaign_kind, "For a new campaign: full_scale (default) or wind_tunnel")
+      ->check(CLI::IsMember({"full_scale", "wind_tunnel"}));
+  imp->add_option("--session", o.meta.session, "Session within the campaign (default \"default\")");
+  imp->add_option("--boat", o.meta.boat, "Boat carrying the sail");
+  imp->add_option("--sail", o.meta.sail, "Sail name, created when new (default \"default\")");
+  imp->add_option("--sail-type", o.meta.sail_type, "Sail type: mainsail, genoa, gennaker, spinnaker, ...");
+  imp->add_option("--test", o.meta.test, "Test (a series of trim steps) this scan belongs to");
+  imp->add_option("--trim-step", o.meta.trim_step, "Order of the trim step within the test (default 0)");
+  imp->add_option("--awa", o.awa, "Apparent wind angle, degrees");
+  imp->add_option("--aws", o.aws, "Apparent wind speed, m/s");
+  imp->add_option("--drive", o.drive, "Measured drive force, N");
+  imp->add_option("--side", o.side, "Measured side force, N");
+  imp->add_option("--heel", o.heel, "Measured heel moment, N·m");
+  imp->add_option("--set", o.sets, "Control setting NAME=VALUE (tack_height, sheet, traveller, halyard, ...); repeatable")->allow_extra_args(false);
+  imp->add_option("--pressure", o.pressures, "Pressure tap TAP=PASCAL; repeatable")->allow_extra_args(false);
+  imp->add_option("--unit", o.meta.scanner_unit, "Scanner unit serial");
+  imp->add_option("--scanned-at", o.meta.scanned_at, "Scan time, ISO 8601");
+  imp->add_option("--raw-capture", o.meta.raw_capture, "Reference to the raw capture (default: the input file)");
+}
+
+// `db show`: one scan, its sections and the sections it could not measure; optionally its stored cloud.
+void runShow(const DbOptions& o) {
+  Database d = openSailDatabase(o.db, openOptions(o, false));
+  ScanFilter f;
+  f.scan_id = o.scan_id;
+  const Table scan = findScans(d, f);
+  if (scan.rows.empty()) throw InvalidInput("db show: no scan " + std::to_string(o.scan_id) + " in " + o.db);
+  if (!o.cloud_file.empty()) {
+    const ScanRecord record = loadScanRecord(d, o.scan_id);
+    if (!record.cloud)
+      throw InvalidInput("db show: scan " + std::to_string(o.scan_id) + " has no stored cloud (only its analysis was imported)");
+    writeCloud(o.cloud_file, *record.cloud);
+    std::fprintf(stderr, "wrote the stored cloud of scan %lld (%zu points) to %s\n", static_cast<long long>(o.scan_id),
+                 record.cloud->size(), o.cloud_file.c_str());
+  }
+  const Table sections = findSections(d, f);
+  // Sections the latest analysis was asked for but could not measure.
+  const int64_t analysis_id = latestAnalysisId(d, o.scan_id);
+  const std::vector<UnmeasuredSection> unmeasured =
+      analysis_id == 0 ? std::vector<UnmeasuredSection>{} : unmeasuredSections(d, analysis_id);
+  if (o.json) {
+    nlohmann::ordered_json j = tableToJson(scan)[0];
+    j["sections"] = tableToJson(sections);
+    j["unmeasured_sections"] = unmeasuredSectionsToJson(unmeasured);
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  for (size_t c = 0; c < scan.columns.size(); ++c) std::printf("%-15s %s\n", scan.columns[c].c_str(), text(scan.rows[0][c]).c_str());
+  std::printf("\n");
+  printTable(sections);
+  for (const UnmeasuredSection& u : unmeasured)
+    std::printf("section %.3f not measured: %s\n", u.fraction, u.reason.c_str());
+}
+
+// `db export`: a query's result to a file, CSV or JSON by flag or by the file's extension.
+void runExport(const DbOptions& o) {
+  std::string format = o.csv ? "csv" : o.json ? "json" : "";
+  if (format.empty()) {
+    if (endsWith(o.dest, ".csv")) format = "csv";
+    else if (endsWith(o.dest, ".json")) format = "json";
+    else throw InvalidInput("db export: give --csv or --json (\"" + o.dest + "\" has neither extension)");
+  }
+  Database d = openSailDatabase(o.db, openOptions(o, false));
+  const Table t = runQuery(d, o);
+  writeTable(o.dest, t, format);
+  std::printf("wrote %zu rows to %s\n", t.rows.size(), o.dest.c_str());
+}
+
+// `db check`: integrity and foreign keys of the file as it is; throws DatabaseError on any problem.
+void runCheck(const DbOptions& o) {
+  OpenOptions oo = openOptions(o, false);
+  Database d(o.db, oo);  // no migration: check the file as it is
+  const int version = d.userVersion();
+  if (version > kSchemaVersion)
+    throw DatabaseError("db check: " + o.db + ": database schema version " + std::to_string(version) +
+                        " is newer than this sailshape (" + std::to_string(kSchemaVersion) + ")");
+  const std::vector<std::string> problems = d.integrityCheck();
+  if (!problems.empty()) {
+    for (const auto& p : problems) std::fprintf(stderr, "  %s\n", p.c_str());
+    throw DatabaseError("db check: " + o.db + ": " + std::to_string(problems.size()) + " problem(s), first: " + problems[0]);
+  }
+  std::printf("%s: ok (schema version %d)\n", o.db.c_str(), version);
+}
+
 }  // namespace
 
 void addDbCommand(CLI::App& app) {
@@ -237,27 +326,7 @@ void addDbCommand(CLI::App& app) {
   CLI::App* imp = db->add_subcommand(
       "import", "Store one scan in one transaction: FILE is the JSON of `sailshape analyze --json` or a cloud file");
   add_db(imp);
-  imp->add_option("FILE", o->file, "Analysis JSON (.json) or cloud (.ply, .pcd, .xyz, .txt, .csv)")->required()->check(CLI::ExistingFile);
-  imp->add_option("--cloud", o->cloud_file, "With an analysis JSON FILE: also store this cloud (compressed)")->check(CLI::ExistingFile);
-  imp->add_option("--campaign", o->meta.campaign, "Campaign name, created when new (default \"default\")");
-  imp->add_option("--campaign-kind", o->meta.campaign_kind, "For a new campaign: full_scale (default) or wind_tunnel")
-      ->check(CLI::IsMember({"full_scale", "wind_tunnel"}));
-  imp->add_option("--session", o->meta.session, "Session within the campaign (default \"default\")");
-  imp->add_option("--boat", o->meta.boat, "Boat carrying the sail");
-  imp->add_option("--sail", o->meta.sail, "Sail name, created when new (default \"default\")");
-  imp->add_option("--sail-type", o->meta.sail_type, "Sail type: mainsail, genoa, gennaker, spinnaker, ...");
-  imp->add_option("--test", o->meta.test, "Test (a series of trim steps) this scan belongs to");
-  imp->add_option("--trim-step", o->meta.trim_step, "Order of the trim step within the test (default 0)");
-  imp->add_option("--awa", o->awa, "Apparent wind angle, degrees");
-  imp->add_option("--aws", o->aws, "Apparent wind speed, m/s");
-  imp->add_option("--drive", o->drive, "Measured drive force, N");
-  imp->add_option("--side", o->side, "Measured side force, N");
-  imp->add_option("--heel", o->heel, "Measured heel moment, N·m");
-  imp->add_option("--set", o->sets, "Control setting NAME=VALUE (tack_height, sheet, traveller, halyard, ...); repeatable")->allow_extra_args(false);
-  imp->add_option("--pressure", o->pressures, "Pressure tap TAP=PASCAL; repeatable")->allow_extra_args(false);
-  imp->add_option("--unit", o->meta.scanner_unit, "Scanner unit serial");
-  imp->add_option("--scanned-at", o->meta.scanned_at, "Scan time, ISO 8601");
-  imp->add_option("--raw-capture", o->meta.raw_capture, "Reference to the raw capture (default: the input file)");
+  addImportOptions(imp, *o);
   imp->callback([o] { runImport(*o); });
 
   CLI::App* list = db->add_subcommand("list", "List the scans (optionally filtered)");
@@ -278,38 +347,7 @@ void addDbCommand(CLI::App& app) {
                    "Also write the scan's stored cloud to this file (.ply, .pcd, .xyz or .csv by its extension): its "
                    "points with their intensity and scan angles, and the scanner's viewpoint, as stored; "
                    "`sailshape analyze FILE --scanner MODEL` re-analyses it as the first analysis did");
-  show->callback([o] {
-    Database d = openSailDatabase(o->db, openOptions(*o, false));
-    ScanFilter f;
-    f.scan_id = o->scan_id;
-    const Table scan = findScans(d, f);
-    if (scan.rows.empty()) throw InvalidInput("db show: no scan " + std::to_string(o->scan_id) + " in " + o->db);
-    if (!o->cloud_file.empty()) {
-      const ScanRecord record = loadScanRecord(d, o->scan_id);
-      if (!record.cloud)
-        throw InvalidInput("db show: scan " + std::to_string(o->scan_id) + " has no stored cloud (only its analysis was imported)");
-      writeCloud(o->cloud_file, *record.cloud);
-      std::fprintf(stderr, "wrote the stored cloud of scan %lld (%zu points) to %s\n", static_cast<long long>(o->scan_id),
-                   record.cloud->size(), o->cloud_file.c_str());
-    }
-    const Table sections = findSections(d, f);
-    // Sections the latest analysis was asked for but could not measure.
-    const int64_t analysis_id = latestAnalysisId(d, o->scan_id);
-    const std::vector<UnmeasuredSection> unmeasured =
-        analysis_id == 0 ? std::vector<UnmeasuredSection>{} : unmeasuredSections(d, analysis_id);
-    if (o->json) {
-      nlohmann::ordered_json j = tableToJson(scan)[0];
-      j["sections"] = tableToJson(sections);
-      j["unmeasured_sections"] = unmeasuredSectionsToJson(unmeasured);
-      std::cout << j.dump(2) << "\n";
-      return;
-    }
-    for (size_t c = 0; c < scan.columns.size(); ++c) std::printf("%-15s %s\n", scan.columns[c].c_str(), text(scan.rows[0][c]).c_str());
-    std::printf("\n");
-    printTable(sections);
-    for (const UnmeasuredSection& u : unmeasured)
-      std::printf("section %.3f not measured: %s\n", u.fraction, u.reason.c_str());
-  });
+  show->callback([o] { runShow(*o); });
 
   CLI::App* query = db->add_subcommand("query", "Query the reference database; prints a table, CSV or JSON");
   add_db(query);
@@ -328,35 +366,11 @@ void addDbCommand(CLI::App& app) {
   auto* csv = exp->add_flag("--csv", o->csv, "Write CSV");
   auto* json = exp->add_flag("--json", o->json, "Write JSON");
   csv->excludes(json);
-  exp->callback([o] {
-    std::string format = o->csv ? "csv" : o->json ? "json" : "";
-    if (format.empty()) {
-      if (endsWith(o->dest, ".csv")) format = "csv";
-      else if (endsWith(o->dest, ".json")) format = "json";
-      else throw InvalidInput("db export: give --csv or --json (\"" + o->dest + "\" has neither extension)");
-    }
-    Database d = openSailDatabase(o->db, openOptions(*o, false));
-    const Table t = runQuery(d, *o);
-    writeTable(o->dest, t, format);
-    std::printf("wrote %zu rows to %s\n", t.rows.size(), o->dest.c_str());
-  });
+  exp->callback([o] { runExport(*o); });
 
   CLI::App* check = db->add_subcommand("check", "Check the file's integrity and foreign keys; exit 0 only when consistent");
   add_db(check);
-  check->callback([o] {
-    OpenOptions oo = openOptions(*o, false);
-    Database d(o->db, oo);  // no migration: check the file as it is
-    const int version = d.userVersion();
-    if (version > kSchemaVersion)
-      throw DatabaseError("db check: " + o->db + ": database schema version " + std::to_string(version) +
-                          " is newer than this sailshape (" + std::to_string(kSchemaVersion) + ")");
-    const std::vector<std::string> problems = d.integrityCheck();
-    if (!problems.empty()) {
-      for (const auto& p : problems) std::fprintf(stderr, "  %s\n", p.c_str());
-      throw DatabaseError("db check: " + o->db + ": " + std::to_string(problems.size()) + " problem(s), first: " + problems[0]);
-    }
-    std::printf("%s: ok (schema version %d)\n", o->db.c_str(), version);
-  });
+  check->callback([o] { runCheck(*o); });
 
   CLI::App* backup = db->add_subcommand("backup", "Copy the database online (SQLite backup API) to DEST");
   add_db(backup);

@@ -15,6 +15,7 @@
 #include "acquisition/scene.hpp"
 #include "acquisition/sweep.hpp"
 #include "acquisition/sync.hpp"
+#include "acquisition/tunnel.hpp"
 #include "acquisition/unit_config.hpp"
 #include "analysis/core/units.hpp"
 #include "analysis/pipeline/analysis_json.hpp"
@@ -37,15 +38,20 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-constexpr double kModelScale = 1.0 / 3.6;  // the built-in tunnel's yacht model
 const char* const kTest = "A2 tack ease";
+
+// The emulator's tunnel: its scene is ray-cast from this, and the demo registers on its walls and looks for its spars.
+const TunnelDescription& tunnel() {
+  static const TunnelDescription t = builtInTunnel();
+  return t;
+}
 
 // --- the sails: designs, and how they fly at each trim step ---------------------
 
-SailDesign mainDesign() { return scaleDesign(exampleDesign(SailType::Main), kModelScale); }
+SailDesign mainDesign() { return scaleDesign(exampleDesign(SailType::Main), tunnel().model_scale); }
 
 SailDesign gennakerDesign() {
-  SailDesign d = scaleDesign(exampleDesign(SailType::Gennaker), kModelScale);
+  SailDesign d = scaleDesign(exampleDesign(SailType::Gennaker), tunnel().model_scale);
   // Fractional A2 on a bowsprit: the head sits below the model's masthead and the tunnel's ceiling.
   d.luff_m = 3.06;
   d.leech_m = 2.75;
@@ -101,26 +107,6 @@ Scene tunnelAtStep(int step) {
   }
   return scene;
 }
-
-// The built-in tunnel's chamber (acquisition/scene.cpp) as faces known in the boat frame.
-BoatReference tunnelWalls() {
-  const Vec3 lo(-8.0, -7.0, -0.6), hi(8.0, 7.0, 3.2);
-  BoatReference ref;
-  ref.name = "wind tunnel chamber";
-  ref.faces = {{"floor", Vec3::UnitZ(), lo.z()},          {"ceiling", -Vec3::UnitZ(), -hi.z()},
-               {"starboard wall", Vec3::UnitY(), lo.y()}, {"port wall", -Vec3::UnitY(), -hi.y()},
-               {"aft wall", Vec3::UnitX(), lo.x()},       {"forward wall", -Vec3::UnitX(), -hi.x()}};
-  return ref;
-}
-
-// The built-in tunnel model's mast and boom (acquisition/scene.cpp builtInTunnelScene),
-// in the boat frame as the crew measures them once per boat.
-std::vector<Spar> tunnelSpars() {
-  Spar mast{"mast", Vec3(0.035, 0, 0), Vec3::UnitZ(), 3.05, 0.025};
-  Spar boom{"boom", Vec3(0.0, 0, 0.26), -Vec3::UnitX(), 1.05, 0.015};
-  return {mast, boom};
-}
-constexpr double kDeckZ = 0.0;
 
 // --- the two units ------------------------------------------------------------------
 
@@ -225,13 +211,13 @@ struct EmulatedUnit {
 };
 
 // The region of interest a crew draws around each sail (study §5.4): the designed
-// sail's bounding box grown by `margin_m`, less the deck and a clearance of
-// `clearance_m` around the spars, whose points region growing cannot always tell
+// sail's bounding box grown by `margin_m`, less what lies within `clearance_m` above the
+// deck (at `deck_z_m`) or around the spars, whose points region growing cannot always tell
 // from the sail where the luff and foot touch them at model scale, and forward of
 // `max_x_m` (a mainsail's box ends at the mast: beyond it lie the mast's mixed
 // pixels and the headsail).
-Cloud cropToSail(const Cloud& cloud, const Mesh& design, double margin_m, double clearance_m, double max_x_m,
-                 const std::vector<Spar>& spars) {
+Cloud cropToSail(const Cloud& cloud, const Mesh& design, double margin_m, double deck_z_m, double clearance_m,
+                 double max_x_m, const std::vector<Spar>& spars) {
   Eigen::AlignedBox3d box;
   for (const Vec3& v : design.vertices) box.extend(v);
   box.min().array() -= margin_m;
@@ -244,7 +230,7 @@ Cloud cropToSail(const Cloud& cloud, const Mesh& design, double margin_m, double
   std::vector<uint32_t> keep;
   for (size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3& p = cloud.points[i];
-    if (box.contains(p) && p.x() < max_x_m && p.z() > kDeckZ + clearance_m && !nearSpar(p))
+    if (box.contains(p) && p.x() < max_x_m && p.z() > deck_z_m + clearance_m && !nearSpar(p))
       keep.push_back(static_cast<uint32_t>(i));
   }
   Cloud out = selectPoints(cloud, keep);
@@ -295,260 +281,345 @@ std::string isoNow() {
   return buf;
 }
 
-}  // namespace
-
-DemoResult runDemo(const DemoOptions& o, const DemoLog& log_fn, const Progress& progress) {
+void validateDemoOptions(const DemoOptions& o) {
   if (o.steps < 1 || o.steps > 10) throw InvalidInput("[runDemo] steps must be in 1..10 (got " + std::to_string(o.steps) + ")");
   if (o.sections < 1 || o.sections > 20)
     throw InvalidInput("[runDemo] sections must be in 1..20 (got " + std::to_string(o.sections) + ")");
   if (o.scan_lines < 20 || o.scan_lines > 2000)
     throw InvalidInput("[runDemo] scan_lines must be in 20..2000 (got " + std::to_string(o.scan_lines) + ")");
-  const auto t0 = std::chrono::steady_clock::now();
-  auto log = [&](const std::string& m) {
-    if (log_fn) log_fn(m);
-  };
+}
 
+// What every trim step shares, set up once: the output folders, the rig and what the crew measured of the tunnel.
+struct DemoRun {
+  DemoOptions options;
+  DemoLog log;
+  Progress progress;
+  std::string capture_dir;  // raw telegrams per step and unit
+  std::string cloud_dir;    // what each sail's analysis started from (boat frame), for other tools
+  SectionParams sections;
+  std::vector<RigUnit> rig;
+  BoatReference walls;
+  std::vector<Spar> spars;  // where the crew measured them, boat frame
+  std::string session;
+  EmulatedTurntableParams turntable;
+  std::vector<std::optional<RigidTransform>> stored;  // per unit: its registration until it moves
   DemoResult result;
+};
+
+// Creates the output folders; throws InvalidInput when `dir` already holds a database.
+void prepareOutput(DemoRun& run) {
+  const DemoOptions& o = run.options;
   fs::create_directories(o.dir);
-  result.database = (fs::path(o.dir) / "sailshape.db").string();
-  if (fs::exists(result.database))
-    throw InvalidInput("[runDemo] " + result.database + " already exists; choose another --dir or remove it");
-  const std::string capture_dir = (fs::path(o.dir) / "captures").string();
-  fs::create_directories(capture_dir);
-  // What each sail's analysis started from (boat frame), for other tools; full scans are in the database.
-  const std::string cloud_dir = (fs::path(o.dir) / "clouds").string();
-  fs::create_directories(cloud_dir);
+  run.result.database = (fs::path(o.dir) / "sailshape.db").string();
+  if (fs::exists(run.result.database))
+    throw InvalidInput("[runDemo] " + run.result.database + " already exists; choose another --dir or remove it");
+  run.capture_dir = (fs::path(o.dir) / "captures").string();
+  fs::create_directories(run.capture_dir);
+  // Full scans are in the database.
+  run.cloud_dir = (fs::path(o.dir) / "clouds").string();
+  fs::create_directories(run.cloud_dir);
+}
 
-  SectionParams sp;
-  sp.count = o.sections;
-  std::vector<RigUnit> rig = makeRig(o, sp);
-  for (const RigUnit& u : rig) {
-    const std::string path = (fs::path(o.dir) / (u.config.name + ".json")).string();
+void writeUnitFiles(DemoRun& run) {
+  for (const RigUnit& u : run.rig) {
+    const std::string path = (fs::path(run.options.dir) / (u.config.name + ".json")).string();
     std::ofstream(path) << unitToJson(u.config) << "\n";
-    result.unit_files.push_back(path);
+    run.result.unit_files.push_back(path);
   }
-  {  // What the emulator really did, to check the demo's results against: where each
-     // unit stood (4×4 row-major, scanner to boat frame, as the database's registrations).
-    json units = json::array();
-    for (const RigUnit& u : rig) {
-      json rows = json::array();
-      for (int r = 0; r < 4; ++r) rows.push_back({u.true_pose(r, 0), u.true_pose(r, 1), u.true_pose(r, 2), u.true_pose(r, 3)});
-      units.push_back({{"name", u.config.name}, {"sail", u.sail}, {"true_pose", rows}});
-    }
-    std::ofstream(fs::path(o.dir) / "emulator-truth.json") << json{{"units", units}}.dump(2) << "\n";
+}
+
+// What the emulator really did, to check the demo's results against: where each
+// unit stood (4×4 row-major, scanner to boat frame, as the database's registrations).
+void writeEmulatorTruth(const DemoRun& run) {
+  json units = json::array();
+  for (const RigUnit& u : run.rig) {
+    json rows = json::array();
+    for (int r = 0; r < 4; ++r) rows.push_back({u.true_pose(r, 0), u.true_pose(r, 1), u.true_pose(r, 2), u.true_pose(r, 3)});
+    units.push_back({{"name", u.config.name}, {"sail", u.sail}, {"true_pose", rows}});
   }
+  std::ofstream(fs::path(run.options.dir) / "emulator-truth.json") << json{{"units", units}}.dump(2) << "\n";
+}
 
-  {  // the database stays open while the steps are stored; the report reads the closed file
-    Database db = openSailDatabase(result.database);
-    for (const RigUnit& u : rig) {
-      SailInfo info;
-      info.name = u.sail;
-      info.type = sailTypeName(u.design.type);
-      info.boat = "Demo 36 (1:3.6 tunnel model)";
-      info.designer = "sailshape generator";
-      const json params = designToJson(u.design);
-      upsertSail(db, info, &u.design_mesh, &params);
-    }
-
-    const BoatReference walls = tunnelWalls();
-    std::vector<std::optional<RigidTransform>> stored(rig.size());
-    const std::string session = "demo " + isoNow();
-    EmulatedTurntableParams tp;
-    tp.home_speed_deg_s = 180;
-    tp.acceleration_deg_s2 = 400;
-
-    for (int step = 0; step < o.steps; ++step) {
-      const std::string tag = "step " + std::to_string(step + 1) + "/" + std::to_string(o.steps);
-      log(tag + ": gennaker tack eased " + std::to_string(static_cast<int>(std::lround(1000 * tackEaseM(step)))) +
-          " mm; synchronised sweep of both units");
-      const Scene scene = tunnelAtStep(step);
-      std::vector<std::unique_ptr<EmulatedUnit>> units;
-      for (size_t i = 0; i < rig.size(); ++i)
-        units.push_back(std::make_unique<EmulatedUnit>(scene, rig[i], o.seed + 1000 * step + i, tp));
-      std::vector<UnitConfig> connect;
-      for (const auto& u : units) connect.push_back(u->connect);
-      SyncOptions so;
-      so.trigger_id = static_cast<uint64_t>(step + 1);
-      for (const RigUnit& u : rig) so.capture_paths.push_back(capturePath(capture_dir, step, u));
-      SynchronisedSweeps synced = runSynchronisedSweeps(connect, so, progress);
-      units.clear();  // the emulators stop: the sweeps are in
-      for (size_t i = 0; i < synced.errors.size(); ++i)
-        if (!synced.errors[i].empty())
-          throw ScannerError("[runDemo] " + tag + ": " + rig[i].config.name + " did not sweep: " + synced.errors[i]);
-      std::vector<Sweep>& sweeps = synced.sweeps;
-      const double spread_ms = 1000.0 * synced.start_spread_s;
-
-      std::vector<std::pair<double, double>> area_camber;
-      std::vector<double> heights;
-      std::vector<std::optional<SailAnalysis>> analyses(rig.size());
-      std::vector<DemoUnitStep> rows(rig.size());
-      std::vector<RigidTransform> used(rig.size());
-      std::vector<Cloud> boat_clouds(rig.size());
-      std::vector<DesignComparison> comparisons(rig.size());
-      std::vector<BoatRegistration> registrations(rig.size());
-      for (size_t i = 0; i < rig.size(); ++i) {
-        const RigUnit& u = rig[i];
-        const Sweep& s = sweeps[i];
-        DemoUnitStep& row = rows[i];
-        row.unit = u.config.name;
-        row.sail = u.sail;
-        row.step = step + 1;
-        row.points = s.cloud.size();
-        row.partial = s.partial;
-        row.start_spread_ms = spread_ms;
-        if (s.partial) result.warnings.push_back(tag + " " + u.config.name + ": partial sweep (" + s.message + ")");
-        for (const std::string& w : s.warnings) result.warnings.push_back(tag + " " + u.config.name + ": " + w);
-
-        log(tag + ": " + u.config.name + ": registering on the tunnel walls");
-        BoatRegistrationParams bp;
-        bp.prior_rotation = u.config.pose.linear();
-        bp.prior_tolerance_deg = 15;
-        registrations[i] = registerToBoat(s.cloud, walls, bp, progress);
-        const BoatRegistration& reg = registrations[i];
-        if (!reg.accepted)
-          result.warnings.push_back(tag + " " + u.config.name + ": wall registration not accepted (fitness " +
-                                    std::to_string(1000 * reg.fitness_rms_m) + " mm)");
-        if (!stored[i]) {
-          stored[i] = reg.transform;
-        } else {
-          // Registrations of an unmoved unit differ by the sensor's σ-level fitness plus the
-          // range's systematic error (SPEC §3: up to 0.3 % of range) on whichever walls carry
-          // them: two fits leaning on different walls differ by up to that over the farthest.
-          double farthest_m = 0;
-          for (const ReferenceFace& f : walls.faces)
-            farthest_m = std::max(farthest_m, std::abs(f.normal.dot(u.config.pose.translation()) - f.offset_m));
-          const double tolerance_m = 0.009 + 0.003 * farthest_m;
-          const Drift d = compareTransforms(*stored[i], reg.transform, 5.0, tolerance_m);
-          row.drift_mm = 1000 * d.max_displacement_m;
-          if (d.moved) {
-            result.warnings.push_back(tag + " " + u.config.name + ": the unit moved (" + std::to_string(row.drift_mm) +
-                                      " mm); registered again");
-            stored[i] = reg.transform;
-          }
-        }
-        used[i] = *stored[i];
-        row.registration_rms_mm = 1000 * reg.fitness_rms_m;
-        row.truth_error_deg = rotationDifferenceDeg(used[i].linear(), u.true_pose.linear());
-        row.truth_error_mm = 1000 * (used[i].translation() - u.true_pose.translation()).norm();
-
-        log(tag + ": " + u.config.name + ": analysing " + u.sail);
-        boat_clouds[i] = transformCloud(s.cloud, used[i]);
-        AnalysisParams ap;
-        ap.sections = sp;
-        // The unit's beam: its footprint trims every edge by 1.5-4 cm here, which put the
-        // main's narrow head 11 cm and the A2's 22 cm low.
-        useScannerBeam(ap.outline, u.config.model);
-        ap.outline.design_lengths_m = {u.design_sections.outline.luff_length_m, u.design_sections.outline.leech_length_m,
-                                       u.design_sections.outline.foot_length_m};
-        // The spars where this cloud has them: the registration is good to a couple of
-        // centimetres, as much as the gap between the mast and the luff.
-        std::vector<Spar> spars;
-        for (const Spar& nominal : tunnelSpars()) {
-          SparFitParams fp;
-          fp.sensor_sigma_m = ap.sensor_sigma_m;
-          const SparFit f = fitSpar(boat_clouds[i], nominal, fp);
-          if (f.found)
-            log(tag + ": " + u.config.name + ": " + nominal.name + " found " +
-                std::to_string(static_cast<int>(std::lround(1000 * f.offset.norm()))) + " mm from its measured place");
-          else
-            log(tag + ": " + u.config.name + ": " + f.message + "; its measured place is used");
-          spars.push_back(f.spar);
-        }
-        const double max_x = u.roi_ends_at_mast ? spars.front().base.x() : 1e9;
-        // The whole scan loses its mixed pixels before the crop cuts off the surfaces
-        // behind them (the main's head, seen against the A2, grew a fringe that put it 23 cm high).
-        const Cloud roi =
-            cropToSail(withoutMixedPixels(boat_clouds[i], ap), u.design_mesh, 0.1, 3 * ap.sensor_sigma_m, max_x, spars);
-        writeCloud(cloud_dir + "/step" + std::to_string(step + 1) + "-" + u.sail_file + "-roi.ply", roi);
-        try {
-          analyses[i] = analyzeSail(roi, ap, progress);
-        } catch (const std::exception& e) {
-          // The scan and its registration are still stored; the crew sees why there are no sections.
-          result.warnings.push_back(tag + " " + u.sail + ": analysis failed, scan stored without it: " + e.what());
-        }
-        if (!analyses[i]) {
-          area_camber.emplace_back(meshArea(u.design_mesh), meanCamber(u.design_sections.sections));
-          heights.push_back(u.design_mesh.vertices.empty() ? 0 : meanZ(u.design_mesh.vertices));
-          continue;
-        }
-        const SailAnalysis& a = *analyses[i];
-        row.analysed = true;
-        row.sail_points = a.sail_points;
-        comparisons[i] = compareWithDesign(u.design_mesh, u.design_sections.sections, a.sail_cloud.points, a.sections, progress);
-        row.deviation_rms_mm = 1000 * comparisons[i].stats.rms_m;
-        area_camber.emplace_back(meshArea(a.mesh), meanCamber(a.sections));
-        heights.push_back(a.sail_cloud.points.empty() ? 0 : meanZ(a.sail_cloud.points));
-      }
-
-      const double awa_deg = 110;
-      const Forces forces = simulatedForces(area_camber, awa_deg, heights);
-      log(tag + ": storing in " + result.database);
-      for (size_t i = 0; i < rig.size(); ++i) {
-        const RigUnit& u = rig[i];
-        ImportMetadata m;
-        m.campaign = "sailshape demo (emulated wind tunnel)";
-        m.campaign_kind = "wind_tunnel";
-        m.session = session;
-        m.boat = "Demo 36 (1:3.6 tunnel model)";
-        m.sail = u.sail;
-        m.sail_type = sailTypeName(u.design.type);
-        m.test = kTest;
-        m.trim_step = step + 1;
-        m.awa_deg = awa_deg;
-        m.aws_m_s = 6.0;
-        m.drive_n = forces.drive_n;
-        m.side_n = forces.side_n;
-        m.heel_moment_nm = forces.heel_moment_nm;
-        m.controls = {{"gennaker_tack_ease_m", tackEaseM(step)}};
-        m.scanner_unit = u.config.name;
-        m.scanned_at = isoNow();
-        m.settings = json::parse(unitToJson(u.config));
-        m.settings["forces"] = "simulated by the emulator (not measured)";
-        m.settings["sweep"] = {{"scans", sweeps[i].scans},
-                               {"beams", sweeps[i].beams},
-                               {"partial", sweeps[i].partial},
-                               {"start_spread_ms", rows[i].start_spread_ms}};
-        m.raw_capture = capturePath(capture_dir, step, u);
-        const json doc = analyses[i] ? analysisToJson(*analyses[i]) : json();
-        const ImportResult r = importScan(db, m, analyses[i] ? &doc : nullptr, &boat_clouds[i]);
-        addRegistration(db, r.scan_id, used[i].matrix(), registrations[i].fitness_rms_m, registrations[i].fitness_rms_m);
-        rows[i].scan_id = r.scan_id;
-        result.scans.push_back(rows[i]);
-        if (!analyses[i]) continue;
-        json details = json::array();
-        for (const SectionDelta& d : comparisons[i].sections)
-          details.push_back({{"fraction", d.fraction},
-                             {"design", sectionParametersToJson(d.design)},
-                             {"flying", sectionParametersToJson(d.flying)},
-                             {"delta", sectionParametersToJson(d.delta)}});
-        addDesignComparison(db, r.analysis_id, u.sail, comparisons[i].stats, json{{"sections", details}});
-        for (const SectionDelta& d : comparisons[i].sections)
-          result.sections.push_back({u.sail, step + 1, d.fraction, d.flying.camber_pct, d.flying.draft_pct,
-                                     d.flying.twist_deg, d.delta.camber_pct, d.delta.draft_pct, d.delta.twist_deg});
-        for (const std::string& w : analyses[i]->warnings) result.warnings.push_back(tag + " " + u.sail + ": " + w);
-      }
-    }
-  }
-
+void storeDesigns(Database& db, const std::vector<RigUnit>& rig) {
   for (const RigUnit& u : rig) {
-    log("report: " + u.sail);
+    SailInfo info;
+    info.name = u.sail;
+    info.type = sailTypeName(u.design.type);
+    info.boat = "Demo 36 (1:3.6 tunnel model)";
+    info.designer = "sailshape generator";
+    const json params = designToJson(u.design);
+    upsertSail(db, info, &u.design_mesh, &params);
+  }
+}
+
+// One unit's part of a trim step, from its sweep to what is stored.
+struct UnitStep {
+  DemoUnitStep row;
+  BoatRegistration registration;
+  RigidTransform used;  // scanner to boat frame: the stored registration
+  Cloud boat_cloud;
+  std::optional<SailAnalysis> analysis;  // empty when the analysis failed
+  DesignComparison comparison;
+  // For the simulated forces: the analysed sail's, or its design's when the analysis failed.
+  double area_m2 = 0, mean_camber = 0, centre_height_m = 0;
+};
+
+// Both units sweep the step's scene on a shared trigger; throws ScannerError when a unit did not sweep.
+SynchronisedSweeps sweepStep(const DemoRun& run, int step, const std::string& tag) {
+  const Scene scene = tunnelAtStep(step);
+  std::vector<std::unique_ptr<EmulatedUnit>> units;
+  for (size_t i = 0; i < run.rig.size(); ++i)
+    units.push_back(std::make_unique<EmulatedUnit>(scene, run.rig[i], run.options.seed + 1000 * step + i, run.turntable));
+  std::vector<UnitConfig> connect;
+  for (const auto& u : units) connect.push_back(u->connect);
+  SyncOptions so;
+  so.trigger_id = static_cast<uint64_t>(step + 1);
+  for (const RigUnit& u : run.rig) so.capture_paths.push_back(capturePath(run.capture_dir, step, u));
+  SynchronisedSweeps synced = runSynchronisedSweeps(connect, so, run.progress);
+  units.clear();  // the emulators stop: the sweeps are in
+  for (size_t i = 0; i < synced.errors.size(); ++i)
+    if (!synced.errors[i].empty())
+      throw ScannerError("[runDemo] " + tag + ": " + run.rig[i].config.name + " did not sweep: " + synced.errors[i]);
+  return synced;
+}
+
+// Registers the unit's sweep on the tunnel walls and keeps the stored registration unless the unit moved.
+void registerOnWalls(DemoRun& run, size_t i, const Sweep& sweep, const std::string& tag, UnitStep& out) {
+  const RigUnit& u = run.rig[i];
+  DemoUnitStep& row = out.row;
+  run.log(tag + ": " + u.config.name + ": registering on the tunnel walls");
+  BoatRegistrationParams bp;
+  bp.prior_rotation = u.config.pose.linear();
+  bp.prior_tolerance_deg = 15;
+  out.registration = registerToBoat(sweep.cloud, run.walls, bp, run.progress);
+  const BoatRegistration& reg = out.registration;
+  if (!reg.accepted)
+    run.result.warnings.push_back(tag + " " + u.config.name + ": wall registration not accepted (fitness " +
+                                  std::to_string(1000 * reg.fitness_rms_m) + " mm)");
+  std::optional<RigidTransform>& stored = run.stored[i];
+  if (!stored) {
+    stored = reg.transform;
+  } else {
+    // Registrations of an unmoved unit differ by the sensor's σ-level fitness plus the
+    // range's systematic error (SPEC §3: up to 0.3 % of range) on whichever walls carry
+    // them: two fits leaning on different walls differ by up to that over the farthest.
+    double farthest_m = 0;
+    for (const ReferenceFace& f : run.walls.faces)
+      farthest_m = std::max(farthest_m, std::abs(f.normal.dot(u.config.pose.translation()) - f.offset_m));
+    const double tolerance_m = 0.009 + 0.003 * farthest_m;
+    const Drift d = compareTransforms(*stored, reg.transform, 5.0, tolerance_m);
+    row.drift_mm = 1000 * d.max_displacement_m;
+    if (d.moved) {
+      run.result.warnings.push_back(tag + " " + u.config.name + ": the unit moved (" + std::to_string(row.drift_mm) +
+                                    " mm); registered again");
+      stored = reg.transform;
+    }
+  }
+  out.used = *stored;
+  row.registration_rms_mm = 1000 * reg.fitness_rms_m;
+  row.truth_error_deg = rotationDifferenceDeg(out.used.linear(), u.true_pose.linear());
+  row.truth_error_mm = 1000 * (out.used.translation() - u.true_pose.translation()).norm();
+}
+
+// The spars where this cloud has them: the registration is good to a couple of
+// centimetres, as much as the gap between the mast and the luff.
+std::vector<Spar> findSpars(const DemoRun& run, const Cloud& boat_cloud, double sensor_sigma_m, const std::string& who) {
+  std::vector<Spar> spars;
+  for (const Spar& nominal : run.spars) {
+    SparFitParams fp;
+    fp.sensor_sigma_m = sensor_sigma_m;
+    const SparFit f = fitSpar(boat_cloud, nominal, fp);
+    if (f.found)
+      run.log(who + ": " + nominal.name + " found " +
+              std::to_string(static_cast<int>(std::lround(1000 * f.offset.norm()))) + " mm from its measured place");
+    else
+      run.log(who + ": " + f.message + "; its measured place is used");
+    spars.push_back(f.spar);
+  }
+  return spars;
+}
+
+// Moves the sweep into the boat frame, crops it to the sail, analyses it and compares it with its design.
+void analyseUnit(DemoRun& run, size_t i, int step, const Sweep& sweep, const std::string& tag, UnitStep& out) {
+  const RigUnit& u = run.rig[i];
+  DemoUnitStep& row = out.row;
+  run.log(tag + ": " + u.config.name + ": analysing " + u.sail);
+  out.boat_cloud = transformCloud(sweep.cloud, out.used);
+  AnalysisParams ap;
+  ap.sections = run.sections;
+  // The unit's beam footprint trims every edge (1.5-4 cm at these ranges); the outline allows for it.
+  useScannerBeam(ap.outline, u.config.model);
+  ap.outline.design_lengths_m = {u.design_sections.outline.luff_length_m, u.design_sections.outline.leech_length_m,
+                                 u.design_sections.outline.foot_length_m};
+  const std::vector<Spar> spars = findSpars(run, out.boat_cloud, ap.sensor_sigma_m, tag + ": " + u.config.name);
+  const double max_x = u.roi_ends_at_mast ? spars.front().base.x() : 1e9;
+  // The whole scan loses its mixed pixels before the crop cuts off the surfaces behind
+  // them that tell them apart (a sail's head seen against the other sail would keep a fringe).
+  const Cloud roi = cropToSail(withoutMixedPixels(out.boat_cloud, ap), u.design_mesh, 0.1, tunnel().hull.deck_z_m,
+                               3 * ap.sensor_sigma_m, max_x, spars);
+  writeCloud(run.cloud_dir + "/step" + std::to_string(step + 1) + "-" + u.sail_file + "-roi.ply", roi);
+  try {
+    out.analysis = analyzeSail(roi, ap, run.progress);
+  } catch (const std::exception& e) {
+    // The scan and its registration are still stored; the crew sees why there are no sections.
+    run.result.warnings.push_back(tag + " " + u.sail + ": analysis failed, scan stored without it: " + e.what());
+  }
+  if (!out.analysis) {
+    out.area_m2 = meshArea(u.design_mesh);
+    out.mean_camber = meanCamber(u.design_sections.sections);
+    out.centre_height_m = u.design_mesh.vertices.empty() ? 0 : meanZ(u.design_mesh.vertices);
+    return;
+  }
+  const SailAnalysis& a = *out.analysis;
+  row.analysed = true;
+  row.sail_points = a.sail_points;
+  out.comparison =
+      compareWithDesign(u.design_mesh, u.design_sections.sections, a.sail_cloud.points, a.sections, run.progress);
+  row.deviation_rms_mm = 1000 * out.comparison.stats.rms_m;
+  out.area_m2 = meshArea(a.mesh);
+  out.mean_camber = meanCamber(a.sections);
+  out.centre_height_m = a.sail_cloud.points.empty() ? 0 : meanZ(a.sail_cloud.points);
+}
+
+// One unit's sweep through registration and analysis.
+UnitStep processUnit(DemoRun& run, size_t i, int step, const std::string& tag, const Sweep& s, double spread_ms) {
+  const RigUnit& u = run.rig[i];
+  UnitStep out;
+  DemoUnitStep& row = out.row;
+  row.unit = u.config.name;
+  row.sail = u.sail;
+  row.step = step + 1;
+  row.points = s.cloud.size();
+  row.partial = s.partial;
+  row.start_spread_ms = spread_ms;
+  if (s.partial) run.result.warnings.push_back(tag + " " + u.config.name + ": partial sweep (" + s.message + ")");
+  for (const std::string& w : s.warnings) run.result.warnings.push_back(tag + " " + u.config.name + ": " + w);
+  registerOnWalls(run, i, s, tag, out);
+  analyseUnit(run, i, step, s, tag, out);
+  return out;
+}
+
+// Stores each unit's scan, registration, analysis and design comparison, with the step's simulated forces.
+void storeStep(DemoRun& run, Database& db, int step, const std::string& tag, const std::vector<Sweep>& sweeps,
+               std::vector<UnitStep>& units) {
+  std::vector<std::pair<double, double>> area_camber;
+  std::vector<double> heights;
+  for (const UnitStep& us : units) {
+    area_camber.emplace_back(us.area_m2, us.mean_camber);
+    heights.push_back(us.centre_height_m);
+  }
+  const double awa_deg = 110;
+  const Forces forces = simulatedForces(area_camber, awa_deg, heights);
+  run.log(tag + ": storing in " + run.result.database);
+  for (size_t i = 0; i < run.rig.size(); ++i) {
+    const RigUnit& u = run.rig[i];
+    UnitStep& us = units[i];
+    ImportMetadata m;
+    m.campaign = "sailshape demo (emulated wind tunnel)";
+    m.campaign_kind = "wind_tunnel";
+    m.session = run.session;
+    m.boat = "Demo 36 (1:3.6 tunnel model)";
+    m.sail = u.sail;
+    m.sail_type = sailTypeName(u.design.type);
+    m.test = kTest;
+    m.trim_step = step + 1;
+    m.awa_deg = awa_deg;
+    m.aws_m_s = 6.0;
+    m.drive_n = forces.drive_n;
+    m.side_n = forces.side_n;
+    m.heel_moment_nm = forces.heel_moment_nm;
+    m.controls = {{"gennaker_tack_ease_m", tackEaseM(step)}};
+    m.scanner_unit = u.config.name;
+    m.scanned_at = isoNow();
+    m.settings = json::parse(unitToJson(u.config));
+    m.settings["forces"] = "simulated by the emulator (not measured)";
+    m.settings["sweep"] = {{"scans", sweeps[i].scans},
+                           {"beams", sweeps[i].beams},
+                           {"partial", sweeps[i].partial},
+                           {"start_spread_ms", us.row.start_spread_ms}};
+    m.raw_capture = capturePath(run.capture_dir, step, u);
+    const json doc = us.analysis ? analysisToJson(*us.analysis) : json();
+    const ImportResult r = importScan(db, m, us.analysis ? &doc : nullptr, &us.boat_cloud);
+    addRegistration(db, r.scan_id, us.used.matrix(), us.registration.fitness_rms_m, us.registration.fitness_rms_m);
+    us.row.scan_id = r.scan_id;
+    run.result.scans.push_back(us.row);
+    if (!us.analysis) continue;
+    json details = json::array();
+    for (const SectionDelta& d : us.comparison.sections)
+      details.push_back({{"fraction", d.fraction},
+                         {"design", sectionParametersToJson(d.design)},
+                         {"flying", sectionParametersToJson(d.flying)},
+                         {"delta", sectionParametersToJson(d.delta)}});
+    addDesignComparison(db, r.analysis_id, u.sail, us.comparison.stats, json{{"sections", details}});
+    for (const SectionDelta& d : us.comparison.sections)
+      run.result.sections.push_back({u.sail, step + 1, d.fraction, d.flying.camber_pct, d.flying.draft_pct,
+                                     d.flying.twist_deg, d.delta.camber_pct, d.delta.draft_pct, d.delta.twist_deg});
+    for (const std::string& w : us.analysis->warnings) run.result.warnings.push_back(tag + " " + u.sail + ": " + w);
+  }
+}
+
+// One trim step: the gennaker's tack eased, both units sweep, each cloud is registered, analysed and stored.
+void runStep(DemoRun& run, Database& db, int step) {
+  const std::string tag = "step " + std::to_string(step + 1) + "/" + std::to_string(run.options.steps);
+  run.log(tag + ": gennaker tack eased " + std::to_string(static_cast<int>(std::lround(1000 * tackEaseM(step)))) +
+          " mm; synchronised sweep of both units");
+  const SynchronisedSweeps synced = sweepStep(run, step, tag);
+  const double spread_ms = 1000.0 * synced.start_spread_s;
+  std::vector<UnitStep> units;
+  for (size_t i = 0; i < run.rig.size(); ++i)
+    units.push_back(processUnit(run, i, step, tag, synced.sweeps[i], spread_ms));
+  storeStep(run, db, step, tag, synced.sweeps, units);
+}
+
+// One PDF trim report per sail, from the closed database.
+void writeReports(DemoRun& run) {
+  for (const RigUnit& u : run.rig) {
+    run.log("report: " + u.sail);
     TrimReportParams rp;
-    rp.db_path = result.database;
+    rp.db_path = run.result.database;
     rp.test = kTest;
     rp.sail = u.sail;
     rp.audience = "designer";
-    rp.out_path = (fs::path(o.dir) / ("report-" + u.sail_file + ".pdf")).string();
+    rp.out_path = (fs::path(run.options.dir) / ("report-" + u.sail_file + ".pdf")).string();
     try {
-      const TrimReport report = writeTrimReport(rp, progress);
-      result.reports.push_back(report.out_path);
-      for (const std::string& w : report.content.warnings) result.warnings.push_back("report " + u.sail + ": " + w);
+      const TrimReport report = writeTrimReport(rp, run.progress);
+      run.result.reports.push_back(report.out_path);
+      for (const std::string& w : report.content.warnings) run.result.warnings.push_back("report " + u.sail + ": " + w);
     } catch (const InvalidInput& e) {
       // A sail none of whose steps could be analysed has no sections to report.
-      result.warnings.push_back("no report for " + u.sail + ": " + e.what());
+      run.result.warnings.push_back("no report for " + u.sail + ": " + e.what());
     }
   }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return result;
+}
+
+}  // namespace
+
+DemoResult runDemo(const DemoOptions& o, const DemoLog& log, const Progress& progress) {
+  validateDemoOptions(o);
+  const auto t0 = std::chrono::steady_clock::now();
+  DemoRun run;
+  run.options = o;
+  run.log = log ? log : [](const std::string&) {};
+  run.progress = progress;
+  prepareOutput(run);
+  run.sections.count = o.sections;
+  run.rig = makeRig(o, run.sections);
+  writeUnitFiles(run);
+  writeEmulatorTruth(run);
+  {  // the database stays open while the steps are stored; the reports read the closed file
+    Database db = openSailDatabase(run.result.database);
+    storeDesigns(db, run.rig);
+    run.walls = tunnelWalls(tunnel());
+    run.spars = tunnelSpars(tunnel());
+    run.stored.resize(run.rig.size());
+    run.session = "demo " + isoNow();
+    run.turntable.home_speed_deg_s = 180;
+    run.turntable.acceleration_deg_s2 = 400;
+    for (int step = 0; step < o.steps; ++step) runStep(run, db, step);
+  }
+  writeReports(run);
+  run.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return std::move(run.result);
 }
 
 }  // namespace sailshape::cli

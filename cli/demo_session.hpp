@@ -14,12 +14,12 @@
 namespace sailshape::cli {
 
 struct DemoOptions {
-  std::string dir = "sailshape-demo";  // receives sailshape.db, the unit files and the captures
+  // Receives sailshape.db, the unit files, emulator-truth.json, the reports, captures/ and clouds/.
+  std::string dir = "sailshape-demo";
   int steps = 3;                       // trim steps of the test (gennaker tack eased each step)
   int sections = 3;                    // per sail, SPEC §5 fractions k/(N+1)
-  // Per sweep and unit: sets the turntable speed. 400 lines, 0.25° apart, put 6 or more
-  // cut points within 10-16 % of either end of the upper sections' short chords (at 250,
-  // 0.4° apart, some ends held 5 and their entry or exit could not be read).
+  // Per sweep and unit: sets the turntable speed. 400 lines, 0.25° apart, give the upper
+  // sections' short chords enough cut points near either end to read their entry and exit.
   int scan_lines = 400;
   // Scanner angular step: the finest each model offers at 25 Hz (LMS511 0.1667°, LMS111 0.25°), or 0.5° when coarse.
   bool coarse = false;
@@ -59,7 +59,7 @@ struct DemoResult {
   double seconds = 0;
 };
 
-// Stage messages for the CLI ("step 2/3: sweeping", ...); progress within a stage goes to `progress`.
+// Stage messages for the CLI ("step 2/3: tunnel-main-lms511: analysing Demo 36 main", ...); progress within a stage goes to `progress`.
 using DemoLog = std::function<void(const std::string& message)>;
 
 // Throws InvalidInput for bad options (and when `dir` already holds a sailshape.db),
