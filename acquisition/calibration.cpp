@@ -7,6 +7,7 @@
 
 #include "acquisition/unit_config.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/spatial/principal_axes.hpp"
 
 namespace sailshape {
@@ -240,7 +241,7 @@ void dropOutliers(Fit& f, const CalibrationParams& params) {
   std::nth_element(abs_res.begin(), abs_res.begin() + abs_res.size() / 2, abs_res.end());
   const double cut = params.outlier_sigmas <= 0 ? std::numeric_limits<double>::infinity()
                                                 : params.outlier_sigmas * 1.4826 * abs_res[abs_res.size() / 2];
-  const double cos_max = std::cos(params.max_incidence_deg * M_PI / 180);
+  const double cos_max = std::cos(params.max_incidence_deg * kRadPerDeg);
   for (size_t k = 0; k < nt; ++k)
     for (size_t i = 0; i < f.targets[k].samples.size(); ++i) {
       const SweepPoint& s = f.targets[k].samples[i];
@@ -298,8 +299,8 @@ void reportFit(const Fit& f, CalibrationResult& result) {
     result.theta_stderr_rad = std::sqrt(std::max(0.0, cov(1, 1)));
   }
   if (!result.converged) result.warnings.push_back("the least-squares fit did not converge");
-  if (result.theta_stderr_rad > 0.5 * M_PI / 180)
-    result.warnings.push_back("θ is poorly determined (±" + std::to_string(result.theta_stderr_rad * 180 / M_PI) +
+  if (result.theta_stderr_rad > 0.5 * kRadPerDeg)
+    result.warnings.push_back("θ is poorly determined (±" + std::to_string(result.theta_stderr_rad * kDegPerRad) +
                               "°): add a second plane at an angle to the first, or sweep a wider β range");
 }
 

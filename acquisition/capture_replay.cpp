@@ -7,6 +7,7 @@
 #include "acquisition/sweep.hpp"
 #include "acquisition/turntable_protocol.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 namespace sailshape {
 
@@ -88,7 +89,7 @@ ReplayCloud replayToCloud(const ReplayResult& replay, const UnitConfig& unit) {
       const double range_m = scanRangeMm(*dist, i) / 1000.0;
       const double alpha_deg = scanAngleDeg(*dist, i);
       const double beta_deg = beta0 + (alpha_deg - alpha0_deg) / 360.0 * rate_deg_per_turn;
-      const double alpha = alpha_deg * M_PI / 180.0, beta = beta_deg * M_PI / 180.0;
+      const double alpha = alpha_deg * kRadPerDeg, beta = beta_deg * kRadPerDeg;
       out.cloud.points.push_back(sweepPointPosition(unit, range_m, alpha, beta));
       out.cloud.alpha_rad.push_back(alpha);
       out.cloud.beta_rad.push_back(beta);

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 namespace sailshape {
 namespace {
@@ -198,6 +199,6 @@ double scanAngleDeg(const ScanChannel& c, size_t i) {
   return (static_cast<double>(c.start_angle) + static_cast<double>(i) * c.angular_step) / 10000.0;
 }
 
-double scanAngleRad(const ScanChannel& c, size_t i) { return scanAngleDeg(c, i) * M_PI / 180.0; }
+double scanAngleRad(const ScanChannel& c, size_t i) { return scanAngleDeg(c, i) * kRadPerDeg; }
 
 }  // namespace sailshape

@@ -4,8 +4,8 @@
 #include <cctype>
 #include <cmath>
 
-#include "analysis/core/errors.hpp"
 #include "analysis/core/cloud.hpp"
+#include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
 #include "analysis/outline/sail_outline.hpp"
 

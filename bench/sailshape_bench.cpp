@@ -33,19 +33,20 @@
 #include "acquisition/ray_caster.hpp"
 #include "acquisition/scene.hpp"
 #include "acquisition/sensor_model.hpp"
-#include "analysis/segmentation/cleaning.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/design/design_compare.hpp"
-#include "analysis/spatial/normals.hpp"
+#include "analysis/design/sail_generator.hpp"
 #include "analysis/pipeline/pipeline.hpp"
 #include "analysis/registration/registration.hpp"
-#include "analysis/design/sail_generator.hpp"
+#include "analysis/segmentation/cleaning.hpp"
 #include "analysis/segmentation/segmentation.hpp"
+#include "analysis/spatial/normals.hpp"
 #include "analysis/surface/smoothing.hpp"
 #include "analysis/surface/surface.hpp"
-#include "tests/support/tunnel_scene.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"
 #include "database/schema.hpp"
+#include "tests/support/tunnel_scene.hpp"
 
 namespace {
 
@@ -104,7 +105,7 @@ std::vector<pcl::PointIndices> pclRegionGrowing(const pcl::PointCloud<pcl::Point
   rg.setInputNormals(normals);
   rg.setSearchMethod(tree);
   rg.setNumberOfNeighbours(p.region_growing.k_neighbours);
-  rg.setSmoothnessThreshold(static_cast<float>(p.region_growing.max_normal_angle_deg / 180.0 * M_PI));
+  rg.setSmoothnessThreshold(static_cast<float>(p.region_growing.max_normal_angle_deg * kRadPerDeg));
   rg.setCurvatureThreshold(static_cast<float>(p.region_growing.max_curvature));
   rg.setMinClusterSize(static_cast<pcl::uindex_t>(p.region_growing.min_points));
   std::vector<pcl::PointIndices> clusters;

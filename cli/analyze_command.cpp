@@ -5,10 +5,10 @@
 #include <memory>
 
 #include "acquisition/sensor_model.hpp"
-#include "analysis/pipeline/analysis_json.hpp"
-#include "analysis/io/cloud_io.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/io/cloud_io.hpp"
 #include "analysis/io/mesh_io.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/pipeline/params_io.hpp"
 #include "analysis/pipeline/pipeline.hpp"
 #include "cli/commands.hpp"

@@ -7,12 +7,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "analysis/pipeline/analysis_json.hpp"
-#include "analysis/io/cloud_io.hpp"
-#include "analysis/design/design_compare.hpp"
-#include "analysis/io/design_import.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/design/design_compare.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/io/design_import.hpp"
 #include "analysis/io/mesh_io.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/pipeline/params_io.hpp"
 #include "analysis/pipeline/pipeline.hpp"
 #include "cli/commands.hpp"

@@ -5,9 +5,9 @@
 #include <iostream>
 #include <memory>
 
-#include "analysis/pipeline/analysis_json.hpp"
-#include "analysis/io/cloud_io.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
 #include "cli/commands.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"

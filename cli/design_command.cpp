@@ -5,12 +5,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "analysis/pipeline/analysis_json.hpp"
-#include "analysis/design/design_compare.hpp"
-#include "analysis/io/design_import.hpp"
 #include "analysis/core/errors.hpp"
-#include "analysis/io/mesh_io.hpp"
+#include "analysis/design/design_compare.hpp"
 #include "analysis/design/sail_generator.hpp"
+#include "analysis/io/design_import.hpp"
+#include "analysis/io/mesh_io.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"
 

@@ -15,6 +15,7 @@
 #include "acquisition/scene.hpp"
 #include "acquisition/unit_config.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "cli/commands.hpp"
 
 namespace sailshape::cli {
@@ -83,7 +84,7 @@ void run(const EmulateOptions& o) {
   } else {
     // Without a unit file: leeward of the built-in tunnel model's sails, as assets/unit-tunnel-leeward.json.
     sp.p_m = 0.105;
-    sp.theta_rad = 12.0 * M_PI / 180;
+    sp.theta_rad = 12.0 * kRadPerDeg;
     sp.pose = makePose(Vec3(0.2, 4.0, 1.3), 0, 0, M_PI);
   }
   EmulatedTurntableParams tp;

@@ -7,9 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "analysis/registration/boat_registration.hpp"
-#include "analysis/io/cloud_io.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/registration/boat_registration.hpp"
 #include "analysis/registration/registration.hpp"
 #include "analysis/registration/rigid_transform.hpp"
 #include "cli/commands.hpp"
@@ -44,7 +45,7 @@ nlohmann::json statsJson(const NeighbourDistanceStats& s) {
 void describe(nlohmann::json& doc, const RigidTransform& t) {
   const Eigen::AngleAxisd aa(t.linear());
   doc["matrix"] = matrixJson(t);
-  doc["rotation_deg"] = aa.angle() * 180.0 / M_PI;
+  doc["rotation_deg"] = aa.angle() * kDegPerRad;
   doc["rotation_axis"] = vec(aa.axis());
   doc["translation_m"] = vec(t.translation());
 }
@@ -52,7 +53,7 @@ void describe(nlohmann::json& doc, const RigidTransform& t) {
 void printSummary(const char* what, const RigidTransform& t) {
   const Eigen::AngleAxisd aa(t.linear());
   std::fprintf(stderr, "%s: rotation %.4f° about (%.4f, %.4f, %.4f), translation (%.4f, %.4f, %.4f) m\n", what,
-               aa.angle() * 180.0 / M_PI, aa.axis().x(), aa.axis().y(), aa.axis().z(), t.translation().x(),
+               aa.angle() * kDegPerRad, aa.axis().x(), aa.axis().y(), aa.axis().z(), t.translation().x(),
                t.translation().y(), t.translation().z());
 }
 
@@ -252,7 +253,7 @@ void addRegisterCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--boat-reference", opt->boat_reference,
                   "JSON file of faces known in boat coordinates (a cube on the deck, tunnel walls; see "
-                  "analysis/boat_registration.hpp): registers the reference cloud to the boat frame; with --moving "
+                  "analysis/registration/boat_registration.hpp): registers the reference cloud to the boat frame; with --moving "
                   "the stored transform maps the moving cloud into the boat frame");
   cmd->add_option("--out", opt->out, "Write the 4x4 transform here (four lines of four numbers)");
   cmd->add_option("--apply", opt->apply, "Write the moving cloud (or the reference, without --moving) transformed");

@@ -4,9 +4,9 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "analysis/io/cloud_io.hpp"
 #include "analysis/core/errors.hpp"
 #include "analysis/design/sail_generator.hpp"
+#include "analysis/io/cloud_io.hpp"
 #include "analysis/sections/sections.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"

@@ -8,8 +8,8 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-#include "analysis/design/design_compare.hpp"
 #include "analysis/core/mesh.hpp"
+#include "analysis/design/design_compare.hpp"
 #include "database/sqlite.hpp"
 
 namespace sailshape {

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "analysis/core/cloud.hpp"
-#include "analysis/sections/luff_curve.hpp"
 #include "analysis/core/mesh.hpp"
+#include "analysis/sections/luff_curve.hpp"
 #include "analysis/sections/sections.hpp"
 #include "database/sqlite.hpp"
 

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/design/design_compare.hpp"
 #include "analysis/core/progress.hpp"
+#include "analysis/design/design_compare.hpp"
 #include "reports/pdf_document.hpp"
 #include "reports/render_views.hpp"
 #include "reports/report_data.hpp"

@@ -4,8 +4,8 @@
 #include <filesystem>
 
 #include "acquisition/sensor_model.hpp"
-#include "analysis/design/design_compare.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/design/design_compare.hpp"
 #include "database/schema.hpp"
 #include "viewer/worker.hpp"
 

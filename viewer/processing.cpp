@@ -4,8 +4,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/pipeline/params_io.hpp"
 #include "database/import.hpp"
 #include "viewer/unit_camera.hpp"
@@ -50,7 +51,7 @@ Cloud cropToBox(const Cloud& cloud, const RoiBox& roi) {
 }
 
 Cloud transformCloud(const Cloud& cloud, const CloudTransform& t) {
-  const double k = M_PI / 180.0;
+  const double k = kRadPerDeg;
   const Eigen::Matrix3d r = (Eigen::AngleAxisd(t.yaw_deg * k, Vec3::UnitZ()) *
                              Eigen::AngleAxisd(t.pitch_deg * k, Vec3::UnitY()) *
                              Eigen::AngleAxisd(t.roll_deg * k, Vec3::UnitX()))

@@ -4,12 +4,13 @@
 
 #include "acquisition/sweep.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 namespace sailshape::viewer {
 
 CameraPlacement unitCamera(const UnitConfig& unit, double distance_m) {
   if (!(distance_m > 0)) throw InvalidInput("[unitCamera] distance_m must be > 0 (got " + std::to_string(distance_m) + ")");
-  const double k = M_PI / 180.0;
+  const double k = kRadPerDeg;
   const double beta = k * (unit.start_angle_deg + unit.sweep_angle_deg / 2);
   const double alpha = k * (unit.output_start_deg + unit.output_stop_deg) / 2;
   CameraPlacement c;

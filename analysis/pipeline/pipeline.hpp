@@ -4,18 +4,18 @@
 #include <string>
 #include <vector>
 
-#include "analysis/segmentation/cleaning.hpp"
 #include "analysis/core/cloud.hpp"
-#include "analysis/sections/luff_curve.hpp"
 #include "analysis/core/mesh.hpp"
-#include "analysis/segmentation/mixed_pixels.hpp"
-#include "analysis/spatial/normals.hpp"
 #include "analysis/core/progress.hpp"
 #include "analysis/outline/sail_outline.hpp"
+#include "analysis/sections/luff_curve.hpp"
 #include "analysis/sections/sections.hpp"
+#include "analysis/segmentation/cleaning.hpp"
+#include "analysis/segmentation/mixed_pixels.hpp"
 #include "analysis/segmentation/segmentation.hpp"
-#include "analysis/surface/smoothing.hpp"
 #include "analysis/segmentation/spars.hpp"
+#include "analysis/spatial/normals.hpp"
+#include "analysis/surface/smoothing.hpp"
 #include "analysis/surface/surface.hpp"
 
 namespace sailshape {

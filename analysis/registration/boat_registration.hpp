@@ -19,9 +19,9 @@
 #include <vector>
 
 #include "analysis/core/cloud.hpp"
-#include "analysis/segmentation/plane_detection.hpp"
 #include "analysis/core/progress.hpp"
 #include "analysis/registration/rigid_transform.hpp"
+#include "analysis/segmentation/plane_detection.hpp"
 
 namespace sailshape {
 

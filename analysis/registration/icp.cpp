@@ -7,6 +7,7 @@
 #include <string>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/spatial/neighbours.hpp"
 #include "analysis/spatial/normals.hpp"
 
@@ -122,7 +123,7 @@ IcpResult refineIcp(const Cloud& reference, const Cloud& moving, const RigidTran
     ref_n = normalsOf(reference, p.normal_k);
     mov_n = normalsOf(moving, p.normal_k);
   }
-  const double cos_normal = std::cos(p.max_normal_angle_deg * M_PI / 180.0);
+  const double cos_normal = std::cos(p.max_normal_angle_deg * kRadPerDeg);
   const double max2 = p.max_correspondence_m * p.max_correspondence_m;
   const long n = static_cast<long>(moving.size());
   std::vector<uint32_t> match(moving.size());
@@ -237,7 +238,7 @@ IcpResult refineIcp(const Cloud& reference, const Cloud& moving, const RigidTran
     }
     result.transform = step * result.transform;
     result.iterations = it + 1;
-    const double rot_deg = Eigen::AngleAxisd(step.linear()).angle() * 180.0 / M_PI;
+    const double rot_deg = Eigen::AngleAxisd(step.linear()).angle() * kDegPerRad;
     if (rot_deg < p.min_step_rotation_deg && step.translation().norm() < p.min_step_translation_m) {
       result.converged = true;
       break;

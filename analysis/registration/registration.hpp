@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "analysis/core/cloud.hpp"
-#include "analysis/registration/icp.hpp"
-#include "analysis/segmentation/plane_detection.hpp"
 #include "analysis/core/progress.hpp"
+#include "analysis/registration/icp.hpp"
 #include "analysis/registration/rigid_transform.hpp"
+#include "analysis/segmentation/plane_detection.hpp"
 
 namespace sailshape {
 

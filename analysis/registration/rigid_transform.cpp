@@ -8,6 +8,7 @@
 #include <string>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/io/text_scan.hpp"
 
 namespace sailshape {
@@ -133,7 +134,7 @@ double rotationDifferenceDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b)
   // acos loses precision near 0; the sine from the skew part keeps small angles exact.
   const Eigen::Matrix3d m = a.transpose() * b;
   const double s = 0.5 * Vec3(m(2, 1) - m(1, 2), m(0, 2) - m(2, 0), m(1, 0) - m(0, 1)).norm();
-  return std::atan2(s, c) * 180.0 / M_PI;
+  return std::atan2(s, c) * kDegPerRad;
 }
 
 Cloud transformCloud(const Cloud& cloud, const RigidTransform& t) {

@@ -15,8 +15,8 @@
 // than both sides) or a gap onto it (farther than both) stays, and so does an edge
 // against the sky, where nothing lies beyond. A steep surface steps evenly and is
 // no edge.
-#include "analysis/segmentation/cleaning.hpp"
 #include "analysis/core/cloud.hpp"
+#include "analysis/segmentation/cleaning.hpp"
 
 namespace sailshape {
 

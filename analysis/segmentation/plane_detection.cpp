@@ -7,6 +7,8 @@
 #include <unordered_map>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/fit.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/spatial/neighbours.hpp"
 #include "analysis/spatial/normals.hpp"
 #include "analysis/spatial/principal_axes.hpp"
@@ -89,24 +91,17 @@ std::vector<uint32_t> fitInliers(const std::vector<Vec3>& pts, const std::vector
 // band cut from a curved sail.
 double bowRms(const std::vector<Vec3>& pts, const std::vector<uint32_t>& indices, const DetectedPlane& plane) {
   const Vec3 u = plane.normal.unitOrthogonal(), v = plane.normal.cross(u);
-  using Vec6 = Eigen::Matrix<double, 6, 1>;
-  auto terms = [&](const Vec3& x) {
-    const Vec3 d = x - plane.centroid;
-    const double a = u.dot(d), b = v.dot(d);
-    return (Vec6() << a * a, a * b, b * b, a, b, 1.0).finished();
-  };
-  Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
-  Vec6 atw = Vec6::Zero();
+  QuadraticHeightField field;
   for (uint32_t i : indices) {
-    const Vec6 t = terms(pts[i]);
-    ata += t * t.transpose();
-    atw += t * plane.normal.dot(pts[i] - plane.centroid);
+    const Vec3 d = pts[i] - plane.centroid;
+    field.add(u.dot(d), v.dot(d), plane.normal.dot(d));
   }
-  const Vec6 coef = ata.ldlt().solve(atw);
+  field.solve();
   double sum2 = 0;
   for (uint32_t i : indices) {
-    const double w = terms(pts[i]).dot(coef);
-    sum2 += w * w;
+    const Vec3 d = pts[i] - plane.centroid;
+    const double bow = field.height(u.dot(d), v.dot(d));
+    sum2 += bow * bow;
   }
   return std::sqrt(sum2 / static_cast<double>(indices.size()));
 }
@@ -294,7 +289,7 @@ PlaneDetection detectPlanes(const Cloud& cloud, const PlaneDetectionParams& p, c
 
   // Merge pieces of one plane (a wall cut in two by a mast's shadow).
   std::sort(planes.begin(), planes.end(), [](const auto& a, const auto& b) { return a.points > b.points; });
-  const double cos_merge = std::cos(p.merge_angle_deg * M_PI / 180.0);
+  const double cos_merge = std::cos(p.merge_angle_deg * kRadPerDeg);
   std::vector<DetectedPlane> merged;
   for (DetectedPlane& pl : planes) {
     bool absorbed = false;

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/spatial/neighbours.hpp"
 #include "analysis/spatial/principal_axes.hpp"
 
@@ -183,7 +184,7 @@ std::optional<Cylinder> cylinderThrough(const Vec3& p1, const Vec3& n1, const Ve
 
 // Whether two round surfaces could be one: axes within 5° and radii within a quarter.
 bool parallelAndAsThick(const Vec3& axis_a, double radius_a, const Vec3& axis_b, double radius_b) {
-  return std::abs(axis_a.dot(axis_b)) >= std::cos(5.0 * M_PI / 180.0) &&
+  return std::abs(axis_a.dot(axis_b)) >= std::cos(5.0 * kRadPerDeg) &&
          std::abs(radius_a - radius_b) <= 0.25 * std::max(radius_a, radius_b);
 }
 
@@ -212,7 +213,7 @@ AxialPosition axialPosition(const Vec3& p, const Cylinder& c) {
 double spannedArcDeg(const std::vector<double>& angles, double min_count = 3) {
   const size_t n = angles.size();
   std::vector<double> deg(3 * n);
-  for (size_t i = 0; i < n; ++i) deg[i] = angles[i] * 180.0 / M_PI;
+  for (size_t i = 0; i < n; ++i) deg[i] = angles[i] * kDegPerRad;
   std::sort(deg.begin(), deg.begin() + static_cast<long>(n));
   for (size_t i = 0; i < n; ++i) {
     deg[n + i] = deg[i] + 360.0;
@@ -240,7 +241,7 @@ bool goesRound(const std::vector<double>& angles, double need_deg) {
   const size_t n = angles.size();
   if (n < 6 || spannedArcDeg(angles, 1) < need_deg) return false;
   std::vector<double> deg(2 * n);
-  for (size_t i = 0; i < n; ++i) deg[i] = angles[i] * 180.0 / M_PI;
+  for (size_t i = 0; i < n; ++i) deg[i] = angles[i] * kDegPerRad;
   std::sort(deg.begin(), deg.begin() + static_cast<long>(n));
   for (size_t i = 0; i < n; ++i) deg[n + i] = deg[i] + 360.0;
   size_t densest = 0;
@@ -257,7 +258,7 @@ bool goesRound(const std::vector<double>& angles, double need_deg) {
 // either side.
 double flatStripArcDeg(double radius, double band) {
   if (radius <= band) return 360.0;
-  return 2.0 * std::atan(2.0 * std::sqrt(radius * band) / (radius - band)) * 180.0 / M_PI;
+  return 2.0 * std::atan(2.0 * std::sqrt(radius * band) / (radius - band)) * kDegPerRad;
 }
 
 // Gauss–Newton on the axis position (2), direction (2) and radius (1) over the points

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "analysis/core/cloud.hpp"
-#include "analysis/spatial/neighbours.hpp"
 #include "analysis/core/progress.hpp"
+#include "analysis/spatial/neighbours.hpp"
 
 namespace sailshape {
 

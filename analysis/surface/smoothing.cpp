@@ -1,6 +1,5 @@
 #include "analysis/surface/smoothing.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>

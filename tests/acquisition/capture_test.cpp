@@ -13,6 +13,7 @@
 #include "acquisition/capture_replay.hpp"
 #include "acquisition/turntable_protocol.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 namespace sailshape {
 namespace {
@@ -169,7 +170,7 @@ TEST(CaptureReplay, CloudFromEncoderFramesFollowsSpec2AndThePose) {
   EXPECT_EQ(c.beams, 62u);
   ASSERT_EQ(c.cloud.size(), 4u);  // two echoes per frame
   EXPECT_TRUE(c.warnings.empty());
-  const double deg = M_PI / 180.0;
+  const double deg = kRadPerDeg;
   // Expected by SPEC §2 written out: β moves 2° per turn, so the beam at α = 180° fires at β0 + 1°.
   auto expected = [&](double r, double alpha_deg, double beta_deg) {
     const double a = alpha_deg * deg, b = beta_deg * deg;

@@ -1,5 +1,5 @@
 // The emulator's mixed pixels (its beam footprint straddling an edge, SPEC §3)
-// against the analysis' filter for them (analysis/mixed_pixels): a turntable
+// against the analysis' filter for them (analysis/segmentation/mixed_pixels): a turntable
 // sweep of a sail panel with a second sail 0.3 m behind it and a wall beyond, as
 // the main's head stands before the gennaker in the tunnel. The sensor model says
 // which samples straddled an edge and where the beam's axis really met a surface.
@@ -13,11 +13,12 @@
 
 #include "acquisition/scene.hpp"
 #include "acquisition/sensor_model.hpp"
+#include "acquisition/tunnel.hpp"
 #include "analysis/core/units.hpp"
-#include "analysis/io/cloud_io.hpp"
-#include "analysis/segmentation/mixed_pixels.hpp"
-#include "analysis/pipeline/pipeline.hpp"
 #include "analysis/design/sail_generator.hpp"
+#include "analysis/io/cloud_io.hpp"
+#include "analysis/pipeline/pipeline.hpp"
+#include "analysis/segmentation/mixed_pixels.hpp"
 
 using namespace sailshape;
 
@@ -136,8 +137,8 @@ TEST(TunnelMainScan, ItsHeadStandsWhereTheWedgeOfItsSamplesPointsBeyondTheFootpr
 
 // The demo's main at step 1 of a run under load, whose emulated LMS511 lost the scan
 // line beside the luff (tests/acquisition/data/README.md): the outermost line there
-// lies 3.9 cm aft of the luff, and the tack came out 3.4 cm off at ±0.6 cm. Told of
-// the lost line (the sweep writes it with the cloud), the tack's σ takes a line
+// lies 3.9 cm aft of the luff, and a tack read off it sits a line spacing in with a σ
+// of a few mm. Told of the lost line (the sweep writes it with the cloud), the tack's σ takes a line
 // spacing (|tack − scanner| × the turntable's step: 1.85 cm at 3.17 m) and covers it.
 TEST(TunnelMainScan, ATackBesideALostScanLineSaysItMayLieALineFurtherOut) {
   const CloudReadResult read = readCloud(std::string(SAILSHAPE_TEST_DATA) + "/tunnel-main-lost-line-roi.ply");
@@ -162,9 +163,9 @@ TEST(TunnelMainScan, ATackBesideALostScanLineSaysItMayLieALineFurtherOut) {
 // The demo's tunnel at step 1 of a run under load whose emulated LMS511 lost 83 of
 // 306 scans (tests/acquisition/data/README.md), among them the one line that fell
 // whole on the 25 mm mast (5 cm across, 3.1 m off; a line a 1.7 cm step, the beam
-// 2.7 cm wide): the mast's body returned nothing, only its foot and head. The vote
-// put it on the sail's luff strip, 6 cm aft, and the 3σ clearance around it cut the
-// luff's two outer lines away: the tack came out 6.6 cm aft. A spar runs its whole
+// 2.7 cm wide): the mast's body returned nothing, only its foot and head. A vote on
+// places alone would put it on the sail's luff strip, 6 cm aft, and the 3σ clearance
+// around it would cut the luff's outer lines away and the tack with them. A spar runs its whole
 // length, and a solid one has no returns inside it: no place here has both, and the
 // mast is not found; its measured place stands, as the demo then uses it.
 TEST(TunnelMainScan, AMastTheSweepDidNotSeeIsNotFoundOnTheSailsLuff) {
@@ -175,7 +176,7 @@ TEST(TunnelMainScan, AMastTheSweepDidNotSeeIsNotFoundOnTheSailsLuff) {
   for (const Vec3& x : read.cloud.points)
     on_body += x.z() > 0.3 && x.z() < 2.9 && std::hypot(x.x() - 0.0383, x.y() + 0.0196) < 0.05;
   ASSERT_EQ(on_body, 0u) << "the scan saw the mast's body after all";
-  const Spar nominal{"mast", Vec3(0.035, 0, 0), Vec3::UnitZ(), 3.05, 0.025};
+  const Spar nominal = builtInTunnel().mast;
   const SparFit f = fitSpar(read.cloud, nominal, SparFitParams{});
   EXPECT_FALSE(f.found) << "found at " << f.spar.base.transpose();
   EXPECT_EQ(f.spar.base, nominal.base);

@@ -8,6 +8,7 @@
 #include "acquisition/ray_caster.hpp"
 #include "acquisition/scene.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 
 using namespace sailshape;
 
@@ -81,7 +82,7 @@ TEST(RayCaster, KnownDistancesAndNormals) {
   EXPECT_NEAR(h.normal.x(), -1.0, 1e-12);
   // 45° in XY: enters the x = 4 face at y = 4·tan... misses (y = 4 > 1); at 10° it hits x = 4.
   EXPECT_FALSE(caster.cast(Vec3::Zero(), Vec3(1, 1, 0)).hit);
-  const double a = 10 * M_PI / 180;
+  const double a = 10 * kRadPerDeg;
   h = caster.cast(Vec3::Zero(), Vec3(std::cos(a), std::sin(a), 0));
   ASSERT_TRUE(h.hit);
   EXPECT_NEAR(h.distance_m, 4.0 / std::cos(a), 1e-12);

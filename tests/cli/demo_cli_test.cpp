@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "tests/cli/run_sailshape.hpp"
 #include "analysis/design/sail_generator.hpp"
 #include "database/schema.hpp"
 #include "database/sqlite.hpp"
+#include "tests/cli/run_sailshape.hpp"
 
 namespace fs = std::filesystem;
 using sailshape::testing::Outcome;

@@ -262,7 +262,7 @@ TEST(TrimReport, DesignIsAnalysedAtTheFlyingFractions) {
   ASSERT_EQ(r.data.steps.size(), size_t(kSteps));
   ASSERT_EQ(r.design_sections.sections.size(), size_t(kSections));
   const SailSurface design(fixture().design);
-  // Clean-data tolerances of the analysis core (tests/analysis/design_compare_test.cpp).
+  // Clean-data tolerances of the analysis core (tests/analysis/design/design_compare_test.cpp).
   for (const Section& s : r.design_sections.sections) {
     SCOPED_TRACE("fraction " + std::to_string(s.fraction));
     const KnownSection k = design.section(s.fraction);
@@ -356,7 +356,7 @@ TEST(TrimReport, OutlineShowsStoredFlyingAndAnalysedDesignLengths) {
   const TrimReportData& r = report.content;
   // The design's edges and area against the generator's exact surface: an 80 × 40
   // mesh of it follows the edges to well under a millimetre; its corners are found
-  // to a few (tests/analysis/design_compare_test.cpp), which moves a length by as much.
+  // to a few (tests/analysis/design/design_compare_test.cpp), which moves a length by as much.
   const SailSurface exact(fixture().design);
   auto arc = [&](auto point) {
     double length = 0;

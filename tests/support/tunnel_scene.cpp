@@ -5,6 +5,7 @@
 #include <string>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/design/sail_generator.hpp"
 
 namespace sailshape {
@@ -30,7 +31,7 @@ std::vector<Rect> sceneRects() {
   r.push_back({Vec3(kX0, kY0, 0), Vec3(lx, 0, 0), Vec3(0, 0, kZ1), Vec3::UnitY(), true});      // starboard wall
   r.push_back({Vec3(kX0, kY1, 0), Vec3(lx, 0, 0), Vec3(0, 0, kZ1), -Vec3::UnitY(), true});     // port wall
   r.push_back({Vec3(kX1, kY0, 0), Vec3(0, ly, 0), Vec3(0, 0, kZ1), -Vec3::UnitX(), true});     // downstream screen
-  const Eigen::Matrix3d rz = Eigen::AngleAxisd(kCubeYawDeg * M_PI / 180.0, Vec3::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d rz = Eigen::AngleAxisd(kCubeYawDeg * kRadPerDeg, Vec3::UnitZ()).toRotationMatrix();
   const double h = kCubeSize / 2;
   for (const Vec3& local : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0)}) {
     const Vec3 n = rz * local, side = rz * Vec3(-local.y(), local.x(), 0);
@@ -43,7 +44,7 @@ std::vector<Rect> sceneRects() {
 }
 
 bool underCube(const Vec3& p) {
-  const Eigen::Matrix3d rz = Eigen::AngleAxisd(kCubeYawDeg * M_PI / 180.0, Vec3::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d rz = Eigen::AngleAxisd(kCubeYawDeg * kRadPerDeg, Vec3::UnitZ()).toRotationMatrix();
   const Vec3 local = rz.transpose() * (p - kCubeCentre);
   return std::abs(local.x()) <= kCubeSize / 2 && std::abs(local.y()) <= kCubeSize / 2;
 }

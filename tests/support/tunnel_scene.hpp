@@ -6,8 +6,8 @@
 // chamber and their own sail — poor overlap, as between real units.
 #include <cstdint>
 
-#include "analysis/registration/boat_registration.hpp"
 #include "analysis/core/cloud.hpp"
+#include "analysis/registration/boat_registration.hpp"
 #include "analysis/registration/rigid_transform.hpp"
 
 namespace sailshape {

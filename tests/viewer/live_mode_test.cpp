@@ -10,9 +10,10 @@
 #include <thread>
 
 #include "acquisition/scene.hpp"
-#include "analysis/io/cloud_io.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/design/sail_generator.hpp"
+#include "analysis/io/cloud_io.hpp"
 #include "analysis/segmentation/spars.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/catalog_tree.hpp"
@@ -219,7 +220,7 @@ TEST(LiveMode, CapturedDeckSweepsKeepTheMastOutOfTheSail) {
     ASSERT_GE(a.spars.size(), 1u);
     const Spar& mast = a.spars[0].spar;
     EXPECT_NEAR(mast.radius_m, 0.09, 2 * options.analysis.sensor_sigma_m);
-    EXPECT_GT(std::abs(mast.axis.z()), std::cos(1.0 * M_PI / 180));
+    EXPECT_GT(std::abs(mast.axis.z()), std::cos(1.0 * kRadPerDeg));
     for (const Vec3& x : a.sail_cloud.points)
       ASSERT_GT(distanceToSpar(x, mast), 2 * options.analysis.sensor_sigma_m) << "a point on the mast: " << x.transpose();
     // Corners within two samples' spacing (0.5° at 12 m is 10 cm).

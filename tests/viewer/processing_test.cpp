@@ -1,11 +1,11 @@
 #include <gtest/gtest.h>
 
+#include "acquisition/unit_config.hpp"
 #include "analysis/core/errors.hpp"
 #include "analysis/design/sail_generator.hpp"
 #include "database/scan_record.hpp"
-#include "viewer/processing.hpp"
 #include "tests/support/footprint_scan.hpp"
-#include "acquisition/unit_config.hpp"
+#include "viewer/processing.hpp"
 #include "viewer_fixture.hpp"
 
 namespace sailshape::viewer {
@@ -162,7 +162,7 @@ TEST(Processing, AStoredScanIsReanalysedWithItsUnitsBeam) {
   const StageResult r = runStages(*record.cloud, params, ProcessingStage::Sections);
   ASSERT_TRUE(r.analysis.has_value());
   // Issue 2's corner target, as the first analysis with the beam reaches it
-  // (tests/analysis/beam_footprint_test.cpp); uncorrected the head is 10 cm and more low.
+  // (tests/analysis/outline/beam_footprint_test.cpp); uncorrected the head is 10 cm and more low.
   EXPECT_LT((r.analysis->outline.head - test::kHead).norm(), 0.03);
   EXPECT_LT((r.analysis->outline.tack - test::kTack).norm(), 0.03);
   EXPECT_NEAR(r.analysis->outline.luff_length_m, (test::kHead - test::kTack).norm(), 0.01);

@@ -10,9 +10,9 @@
 #include <fstream>
 
 #include "acquisition/scene.hpp"
+#include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
 #include "analysis/design/design_compare.hpp"
-#include "analysis/core/errors.hpp"
 #include "analysis/design/sail_generator.hpp"
 #include "database/scan_record.hpp"
 #include "database/schema.hpp"

@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <string>
 
+#include "analysis/design/sail_generator.hpp"
 #include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/pipeline/pipeline.hpp"
-#include "analysis/design/sail_generator.hpp"
 #include "database/catalog.hpp"
 #include "database/import.hpp"
 #include "database/schema.hpp"

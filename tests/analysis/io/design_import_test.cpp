@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "analysis/design/design_compare.hpp"
 #include "analysis/core/errors.hpp"
-#include "analysis/io/mesh_io.hpp"
+#include "analysis/design/design_compare.hpp"
 #include "analysis/design/sail_generator.hpp"
+#include "analysis/io/mesh_io.hpp"
 #include "tests/support/fixtures.hpp"
 
 namespace sailshape {

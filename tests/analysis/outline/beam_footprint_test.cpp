@@ -7,9 +7,9 @@
 #include <cmath>
 #include <string>
 
-#include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/core/cloud.hpp"
 #include "analysis/core/errors.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/pipeline/pipeline.hpp"
 #include "tests/support/footprint_scan.hpp"
 

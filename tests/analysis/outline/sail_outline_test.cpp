@@ -318,12 +318,11 @@ TEST(SailOutline, AHeadWithItsLastSamplesGoneIsPlacedWhereItsEdgesCross) {
 }
 
 // The head with its leech bare beside it: the leech's frontier windows there lie
-// a centimetre or two inside, and the quadratic through them carried that on to
-// the head, which the luff meets lower. The head must stay within issue 2's
-// 3 cm and within three of its own reported σ. Before the corner curves moved on
-// to the samples' lower envelope, seed 4's came out 3.25 cm low with σ 0.39 cm,
-// and seed 1's 1.72 cm with σ 0.65 cm (its leech had left the envelope, the
-// stretch pulling the mean offset out).
+// a centimetre or two inside, and a quadratic through them carries that on to
+// the head, which the luff then meets lower, with a σ of a few mm. The head must
+// stay within the 3 cm corner target and within three of its own reported σ: the
+// corner curves follow the samples' lower envelope, which a bare stretch does not
+// pull in.
 TEST(SailOutline, ALeechBareOfSamplesBelowTheHeadDoesNotPullTheHeadDown) {
   const Vec3 head = SailSurface(exampleDesign(SailType::Jib)).head();
   for (const auto& [seed, depth] : {std::pair<uint64_t, double>{4, 0.015}, {1, 0.02}}) {

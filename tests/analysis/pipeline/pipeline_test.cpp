@@ -10,12 +10,13 @@
 #include <tuple>
 #include <vector>
 
-#include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/core/errors.hpp"
-#include "analysis/sections/luff_curve.hpp"
 #include "analysis/core/mesh.hpp"
-#include "analysis/pipeline/pipeline.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/design/sail_generator.hpp"
+#include "analysis/pipeline/analysis_json.hpp"
+#include "analysis/pipeline/pipeline.hpp"
+#include "analysis/sections/luff_curve.hpp"
 #include "tests/support/fixtures.hpp"
 
 namespace sailshape {
@@ -889,7 +890,7 @@ TEST(Pipeline, ATiltThatLosesTheCurveKeepsTheLastPlaneThatHeldIt) {
   // the next, so every triangle (rows 9 mm apart) some tilt in the range cuts is one
   // a sampled tilt cuts. Triangles no tilt reaches (farther off the start plane than
   // the widest tilt swings at the chord's ends) are kept without the loop.
-  const double reach = 1.1 * (s0.leech_point - s0.luff_point).norm() * std::sin(3.0 * M_PI / 180.0);
+  const double reach = 1.1 * (s0.leech_point - s0.luff_point).norm() * std::sin(3.0 * kRadPerDeg);
   std::vector<Triangle> kept;
   for (const Triangle& t : mesh.triangles) {
     bool near = false;
@@ -897,7 +898,7 @@ TEST(Pipeline, ATiltThatLosesTheCurveKeepsTheLastPlaneThatHeldIt) {
     bool tilted = false;
     for (int k = 0; k <= 135 && near && !tilted; ++k)
       for (double sign : {-1.0, 1.0}) {
-        const double a = sign * (0.3 + 0.02 * k) * M_PI / 180.0;
+        const double a = sign * (0.3 + 0.02 * k) * kRadPerDeg;
         tilted = tilted || cuts(t, (std::cos(a) * m0 + std::sin(a) * e0).normalized());
       }
     if (cuts(t, m0) || !tilted) kept.push_back(t);
@@ -964,8 +965,8 @@ void expectSparseSceneReadsAsTheSailAlone(size_t points, uint64_t seeds) {
       const Spar& boom = a.spars[mast_first ? 1 : 0].spar;
       EXPECT_NEAR(mast.radius_m, 0.07, kSigma);
       EXPECT_NEAR(boom.radius_m, 0.06, kSigma);
-      EXPECT_GT(std::abs(mast.axis.z()), std::cos(10.0 * M_PI / 180.0));
-      EXPECT_LT(std::abs(boom.axis.z()), std::sin(10.0 * M_PI / 180.0));
+      EXPECT_GT(std::abs(mast.axis.z()), std::cos(10.0 * kRadPerDeg));
+      EXPECT_LT(std::abs(boom.axis.z()), std::sin(10.0 * kRadPerDeg));
       // The sail's cluster: at least 98 % of its points, at most 1 % foreign.
       const StageReport& seg = a.stages.front();
       ASSERT_EQ(seg.name, "segmentation");

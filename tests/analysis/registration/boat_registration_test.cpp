@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <fstream>
 
-#include "analysis/registration/registration.hpp"
 #include "analysis/design/sail_generator.hpp"
-#include "tests/support/tunnel_scene.hpp"
+#include "analysis/registration/registration.hpp"
 #include "tests/support/fixtures.hpp"
+#include "tests/support/tunnel_scene.hpp"
 
 namespace sailshape {
 namespace {

@@ -8,8 +8,8 @@
 
 #include <random>
 
-#include "tests/support/tunnel_scene.hpp"
 #include "tests/support/fixtures.hpp"
+#include "tests/support/tunnel_scene.hpp"
 
 namespace sailshape {
 namespace {

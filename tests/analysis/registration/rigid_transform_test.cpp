@@ -7,6 +7,7 @@
 #include <fstream>
 #include <random>
 
+#include "analysis/core/units.hpp"
 #include "tests/support/fixtures.hpp"
 
 namespace sailshape {
@@ -119,8 +120,8 @@ TEST(RotationAligning, TakesOneDirectionOntoAnother) {
 TEST(RotationDifference, MeasuresTheAngleBetweenRotations) {
   const Eigen::Matrix3d a = Eigen::AngleAxisd(0.3, Vec3::UnitY()).toRotationMatrix();
   const Eigen::Matrix3d b = Eigen::AngleAxisd(1e-7, Vec3(1, 1, 0).normalized()).toRotationMatrix() * a;
-  EXPECT_NEAR(rotationDifferenceDeg(a, b), 1e-7 * 180 / M_PI, 1e-12);  // small angles stay exact
-  EXPECT_NEAR(rotationDifferenceDeg(Eigen::Matrix3d::Identity(), a), 0.3 * 180 / M_PI, 1e-9);
+  EXPECT_NEAR(rotationDifferenceDeg(a, b), 1e-7 * kDegPerRad, 1e-12);  // small angles stay exact
+  EXPECT_NEAR(rotationDifferenceDeg(Eigen::Matrix3d::Identity(), a), 0.3 * kDegPerRad, 1e-9);
 }
 
 TEST(TransformCloud, MovesPointsAndViewpoint) {

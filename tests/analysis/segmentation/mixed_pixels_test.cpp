@@ -11,8 +11,9 @@
 #include <set>
 
 #include "analysis/core/errors.hpp"
-#include "analysis/segmentation/mixed_pixels.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/pipeline/pipeline.hpp"
+#include "analysis/segmentation/mixed_pixels.hpp"
 
 using namespace sailshape;
 
@@ -35,7 +36,7 @@ struct Sample {
 // The true range of the sample at grid place (line l, step k), if any.
 using Truth = std::function<std::optional<Sample>(int l, int k)>;
 
-constexpr double kAlpha0 = 80 * M_PI / 180, kBeta0 = -0.3;
+constexpr double kAlpha0 = 80 * kRadPerDeg, kBeta0 = -0.3;
 constexpr int kLines = 120, kSteps = 240;
 
 Cloud scan(const Truth& truth, unsigned seed, std::vector<char>* mixed = nullptr) {
@@ -128,12 +129,12 @@ TEST(MixedPixels, ASteepSurfaceIsNotAnEdge) {
   // sample spacing, evenly; nothing lies between two surfaces.
   const Vec3 mid = direction(kAlpha0 + 120 * kAlphaStep, kBeta0 + 60 * kBetaStep);
   const Vec3 q = kScanner + 3.0 * mid;
-  const Vec3 n = Eigen::AngleAxisd(60 * M_PI / 180, mid.unitOrthogonal()) * -mid;
+  const Vec3 n = Eigen::AngleAxisd(60 * kRadPerDeg, mid.unitOrthogonal()) * -mid;
   double steepest = 0;
   const Cloud c = scan(
       [&](int l, int k) -> std::optional<Sample> {
         const double alpha = kAlpha0 + k * kAlphaStep, beta = kBeta0 + l * kBetaStep + 0.4 * kBetaStep * k / kSteps;
-        const double incidence = std::acos(std::abs(direction(alpha, beta).dot(n))) * 180 / M_PI;
+        const double incidence = std::acos(std::abs(direction(alpha, beta).dot(n))) * kDegPerRad;
         if (incidence > 79) return std::nullopt;
         steepest = std::max(steepest, incidence);
         return Sample{rangeToPlane(l, k, q, n), false};

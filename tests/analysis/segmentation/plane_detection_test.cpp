@@ -7,8 +7,8 @@
 #include <random>
 
 #include "analysis/design/sail_generator.hpp"
-#include "tests/support/tunnel_scene.hpp"
 #include "tests/support/fixtures.hpp"
+#include "tests/support/tunnel_scene.hpp"
 
 namespace sailshape {
 namespace {

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "analysis/core/errors.hpp"
-#include "analysis/spatial/normals.hpp"
 #include "analysis/design/sail_generator.hpp"
+#include "analysis/spatial/normals.hpp"
 #include "tests/support/fixtures.hpp"
 
 namespace sailshape {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
 #include "analysis/design/sail_generator.hpp"
 #include "tests/support/fixtures.hpp"
 
@@ -287,8 +288,8 @@ TEST(EstimateNormals, RobustRefitKeepsAPlaneNormalBesideAPerpendicularWall) {
   for (size_t i = 0; i < floor_points; ++i) {
     const Vec3& p = c.points[i];
     if (p.x() < 0.155 || p.x() > 0.185 || p.y() < 0.05 || p.y() > 0.34) continue;  // 2–4 cm from the wall
-    worst_plain = std::max(worst_plain, std::acos(std::min(1.0, std::abs(a.normals[i].z()))) * 180.0 / M_PI);
-    worst_robust = std::max(worst_robust, std::acos(std::min(1.0, std::abs(b.normals[i].z()))) * 180.0 / M_PI);
+    worst_plain = std::max(worst_plain, std::acos(std::min(1.0, std::abs(a.normals[i].z()))) * kDegPerRad);
+    worst_robust = std::max(worst_robust, std::acos(std::min(1.0, std::abs(b.normals[i].z()))) * kDegPerRad);
   }
   EXPECT_GT(worst_plain, 10.0);
   EXPECT_LT(worst_robust, 0.8 * worst_plain);
