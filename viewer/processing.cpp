@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/core/errors.hpp"
 #include "analysis/pipeline/params_io.hpp"
