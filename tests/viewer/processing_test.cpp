@@ -4,7 +4,7 @@
 #include "analysis/design/sail_generator.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/processing.hpp"
-#include "../analysis/footprint_scan.hpp"
+#include "tests/support/footprint_scan.hpp"
 #include "acquisition/unit_config.hpp"
 #include "viewer_fixture.hpp"
 
