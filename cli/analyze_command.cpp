@@ -4,6 +4,8 @@
 #include <iostream>
 #include <memory>
 
+#include <nlohmann/json.hpp>
+
 #include "acquisition/sensor_model.hpp"
 #include "analysis/core/errors.hpp"
 #include "analysis/io/cloud_io.hpp"

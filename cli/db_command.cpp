@@ -5,6 +5,8 @@
 #include <iostream>
 #include <memory>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/core/errors.hpp"
 #include "analysis/io/cloud_io.hpp"
 #include "analysis/pipeline/analysis_json.hpp"

@@ -9,6 +9,8 @@
 #include <mutex>
 #include <optional>
 
+#include <nlohmann/json.hpp>
+
 #include "acquisition/emulated_turntable.hpp"
 #include "acquisition/scanner_client.hpp"
 #include "acquisition/scanner_emulator.hpp"

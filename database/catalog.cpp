@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/core/errors.hpp"
 
 namespace sailshape {
@@ -143,6 +145,10 @@ int64_t addDesignComparison(Database& db, int64_t analysis_id, const std::string
   s.bind(1, analysis_id).bind(2, sail_id).bind(3, stats.mean_m).bind(4, stats.rms_m).bind(5, stats.max_abs_m);
   s.bind(6, all.dump()).run();
   return db.lastInsertId();
+}
+
+int64_t addDesignComparison(Database& db, int64_t analysis_id, const std::string& sail, const DistanceStats& stats) {
+  return addDesignComparison(db, analysis_id, sail, stats, nlohmann::json::object());
 }
 
 }  // namespace sailshape

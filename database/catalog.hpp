@@ -6,7 +6,7 @@
 #include <string>
 
 #include <Eigen/Core>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "analysis/core/mesh.hpp"
 #include "analysis/design/design_compare.hpp"
@@ -48,7 +48,10 @@ int64_t addRegistration(Database& db, int64_t scan_id, const Eigen::Matrix4d& tr
 Eigen::Matrix4d scanTransform(Database& db, int64_t scan_id);  // the latest; throws InvalidInput when none
 
 // Design-vs-flying statistics of an analysis against its sail's design.
+// `details` (a JSON object, e.g. per-section figures) is stored with the
+// statistics in design_comparisons.stats; without it, the statistics alone.
 int64_t addDesignComparison(Database& db, int64_t analysis_id, const std::string& sail, const DistanceStats& stats,
-                            const nlohmann::json& details = nlohmann::json::object());
+                            const nlohmann::json& details);
+int64_t addDesignComparison(Database& db, int64_t analysis_id, const std::string& sail, const DistanceStats& stats);
 
 }  // namespace sailshape

@@ -2,8 +2,9 @@
 // The compressed cloud stored in scans.cloud: zlib over a small header
 // ("SSC1", point count, flags) and float32 xyz (metres), then what the cloud
 // has of: float32 intensity, float32 scan angles α and β (rad), the float64
-// viewpoint. float32 keeps ≈ 10 µm at 100 m, far below the sensor's σ (SPEC §3).
-// Blobs from before the angles and viewpoint were kept read as they were.
+// viewpoint, the float64 β (rad) of the scan lines its sweep lost; a flag per
+// part says whether it is there. float32 keeps ≈ 10 µm at 100 m, far below the
+// sensor's σ (SPEC §3). A blob without a part reads with that part empty.
 #include <cstdint>
 #include <vector>
 

@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+// The full json header, not json_fwd.hpp: ImportMetadata holds its settings as
+// a json value, which needs the complete type.
 #include <nlohmann/json.hpp>
 
 #include "analysis/core/cloud.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// The reference-database queries. Each returns a Table that export.hpp writes
+// The reference-database queries. Each returns a Table that table_export.hpp writes
 // as CSV or JSON. A scan's sections are those of its latest analysis.
 #include <cstdint>
 #include <optional>

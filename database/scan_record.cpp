@@ -59,11 +59,18 @@ ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
   if (a.step() && !a.isNull(0)) r.analysis_params = nlohmann::json::parse(a.columnText(0), nullptr, false);
   if (r.analysis_params.is_discarded()) r.analysis_params = nullptr;
 
+  r.sections.sections = analysisSections(db, r.analysis_id);
+  r.sections.unmeasured = unmeasuredSections(db, r.analysis_id);
+  return r;
+}
+
+std::vector<Section> analysisSections(Database& db, int64_t analysis_id) {
   Statement x = db.prepare(
       "SELECT fraction, chord_m, camber_pct, draft_pct, twist_deg, twist_rel_deg, entry_deg, exit_deg, u_chord_m,"
       " u_camber_pct, u_draft_pct, u_twist_deg, u_twist_rel_deg, u_entry_deg, u_exit_deg, plane_tilt_deg, converged,"
       " curve FROM sections WHERE analysis_id = ? ORDER BY fraction");
-  x.bind(1, r.analysis_id);
+  x.bind(1, analysis_id);
+  std::vector<Section> sections;
   while (x.step()) {
     Section sec;
     sec.fraction = x.columnDouble(0);
@@ -77,10 +84,35 @@ ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
       sec.leech_point = sec.curve.back();
     }
     sec.curve_samples = sec.curve.size();
-    r.sections.sections.push_back(std::move(sec));
+    sections.push_back(std::move(sec));
   }
-  r.sections.unmeasured = unmeasuredSections(db, r.analysis_id);
-  return r;
+  return sections;
+}
+
+std::optional<ScanSummary> scanSummary(Database& db, int64_t scan_id) {
+  Statement s = db.prepare(
+      "SELECT trim_step_id, scanned_at, (SELECT max(a.id) FROM analyses a WHERE a.scan_id = s.id)"
+      " FROM scans s WHERE s.id = ?");
+  s.bind(1, scan_id);
+  if (!s.step()) return std::nullopt;
+  ScanSummary summary;
+  summary.trim_step_id = s.isNull(0) ? 0 : s.columnInt(0);
+  summary.scanned_at = s.isNull(1) ? "" : s.columnText(1);
+  summary.analysis_id = s.isNull(2) ? 0 : s.columnInt(2);
+  return summary;
+}
+
+std::optional<Cloud> scanCloud(Database& db, int64_t scan_id) {
+  Statement s = db.prepare("SELECT cloud FROM scans WHERE id = ?");
+  s.bind(1, scan_id);
+  if (!s.step() || s.isNull(0)) return std::nullopt;
+  return decompressCloud(s.columnBlob(0));
+}
+
+std::string analysisOutlineJson(Database& db, int64_t analysis_id) {
+  Statement s = db.prepare("SELECT sail FROM analyses WHERE id = ?");
+  s.bind(1, analysis_id);
+  return s.step() && !s.isNull(0) ? s.columnText(0) : std::string();
 }
 
 int64_t latestAnalysisId(Database& db, int64_t scan_id) {

@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+// The full json header, not json_fwd.hpp: ScanRecord holds json values (its
+// parameters and settings), which need the complete type.
 #include <nlohmann/json.hpp>
 
 #include "analysis/core/cloud.hpp"
@@ -33,6 +35,28 @@ struct ScanRecord {
 
 // The id of scan `scan_id`'s latest analysis; 0 when it has none.
 int64_t latestAnalysisId(Database& db, int64_t scan_id);
+
+// Where a scan sits, without its cloud.
+struct ScanSummary {
+  int64_t trim_step_id = 0;  // 0: the scan belongs to no trim step
+  int64_t analysis_id = 0;   // latest analysis; 0 when the scan has none
+  std::string scanned_at;    // ISO 8601, empty when unknown
+};
+// Empty when there is no scan `scan_id`.
+std::optional<ScanSummary> scanSummary(Database& db, int64_t scan_id);
+
+// The stored cloud of scan `scan_id`; empty when none was stored (or no such
+// scan). Throws DatabaseError for a damaged cloud blob.
+std::optional<Cloud> scanCloud(Database& db, int64_t scan_id);
+
+// The sections of analysis `analysis_id` by fraction, as ScanRecord::sections
+// holds them (a parameter stored as NULL is NaN; luff and leech points are the
+// curve's ends).
+std::vector<Section> analysisSections(Database& db, int64_t analysis_id);
+
+// The outline analysis `analysis_id` stored (analyses.sail: the `sail` object of
+// `sailshape analyze --json`, its luff curve inside) as JSON text; empty when none.
+std::string analysisOutlineJson(Database& db, int64_t analysis_id);
 
 // The sections analysis `analysis_id` was asked for but could not measure, with
 // why (stored in its diagnostics by importScan); empty when there were none.

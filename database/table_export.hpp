@@ -3,7 +3,7 @@
 // (an array of objects keyed by column, NULL as null).
 #include <string>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "database/queries.hpp"
 

@@ -56,7 +56,7 @@ PrivateDisplay::PrivateDisplay(int timeout_ms) {
   // first number depends on the process id, so concurrent reports rarely collide,
   // and moves on with every server this process starts: a later report never
   // reuses the name of a server an earlier one stopped (Mesa's GLX keeps state per
-  // display name, and a reused name intermittently met "bad X server connection").
+  // display name, and a reused name intermittently fails with "bad X server connection").
   static std::atomic<int> started_before{0};
   const int first = 200 + static_cast<int>(getpid() % 500) + 40 * started_before++;
   std::string last_error;

@@ -26,8 +26,8 @@ struct ReportSection {
 };
 
 // A sail's outline measures with their 1σ: NaN where not stored (an analysis
-// imported without its `sail` object, or from before the outline carried σ), or
-// not measured (`top_length_m` of a sail without a peak).
+// imported without its `sail` object, or a `sail` object without σ), or not
+// measured (`top_length_m` of a sail without a peak).
 struct OutlineMeasure {
   double value = std::numeric_limits<double>::quiet_NaN(), sigma = std::numeric_limits<double>::quiet_NaN();
 };

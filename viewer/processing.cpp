@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
 #include "analysis/pipeline/analysis_json.hpp"

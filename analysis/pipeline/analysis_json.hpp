@@ -1,6 +1,7 @@
 #pragma once
 // The JSON document of `sailshape analyze --json` (keys carry units: _m, _deg, _pct).
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
+#include <vector>
 
 #include "analysis/pipeline/pipeline.hpp"
 

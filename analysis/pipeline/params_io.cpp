@@ -1,5 +1,6 @@
 #include "analysis/pipeline/params_io.hpp"
 
+#include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>

@@ -1,7 +1,7 @@
 #pragma once
 // Pipeline parameters as JSON (and YAML) documents: every field of
 // AnalysisParams by its name, nested by stage.
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 
 #include "analysis/pipeline/pipeline.hpp"

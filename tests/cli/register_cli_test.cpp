@@ -86,7 +86,7 @@ TEST_F(RegisterCli, PlaneMethodWritesTheTransformTheJsonAndTheMovedCloud) {
   EXPECT_EQ(doc["matrix"].size(), 4u);
   const sailshape::Cloud moved = sailshape::readCloud(path("b_in_a.ply")).cloud;
   ASSERT_EQ(moved.size(), scene_->moving.size());
-  EXPECT_LT((moved.points[0] - scene_->truth * scene_->moving.points[0]).norm(), 0.002 + 0.05 * kRadPerDeg * 5);
+  EXPECT_LT((moved.points[0] - scene_->truth * scene_->moving.points[0]).norm(), 0.002 + 0.05 * sailshape::kRadPerDeg * 5);
 
   // Reapplying the stored transform to a later scan gives the same cloud.
   const Outcome again = sailshape("register --moving " + path("unit_b.ply") + " --transform " + path("t.txt") +

@@ -126,7 +126,7 @@ TEST_F(ReplayCli, UnitFileTurnsEncoderFramesIntoACloud) {
   ASSERT_EQ(cloud.size(), 3u);
   // p = 0, identity pose: α = 90° puts the point at r (0, cos β, sin β) (SPEC §2).
   for (int k = 0; k < 3; ++k) {
-    const double b = 30.0 * k * kRadPerDeg;
+    const double b = 30.0 * k * sailshape::kRadPerDeg;
     EXPECT_LT((cloud.points[k] - sailshape::Vec3(0, 2.5 * std::cos(b), 2.5 * std::sin(b))).norm(), 1e-4) << k;
   }
   const Outcome alone = run("replay " + cap.string() + " --quiet --cloud " + out.string());

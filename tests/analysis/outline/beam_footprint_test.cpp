@@ -3,6 +3,7 @@
 // of every edge by the footprint's reach, and the outline moves the edges and
 // corners back out by it when it knows the beam and where the scanner stood.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <string>

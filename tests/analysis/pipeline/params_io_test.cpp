@@ -1,6 +1,7 @@
 #include "analysis/pipeline/params_io.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>

@@ -1,6 +1,7 @@
 // The whole analysis on synthetic sails whose section parameters are known by
 // construction (analysis/sail_generator), in the tolerances of the core issue.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
