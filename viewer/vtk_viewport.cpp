@@ -311,95 +311,108 @@ void VtkViewport::setScene(const ScanScene* scene, const std::vector<Overlay>& o
   m.pick_marker->SetVisibility(false);
   m.limit_mm = 0;
 
-  if (scene) {
-    const bool dev = o.deviation && (!scene->surface_deviation_m.empty() || !scene->raw_deviation_m.empty());
-    if (dev) {
-      const auto& basis = scene->surface_deviation_m.empty() ? scene->raw_deviation_m : scene->surface_deviation_m;
-      m.limit_mm = o.deviation_range_mm > 0 ? o.deviation_range_mm : std::max(1.0, 1000.0 * percentileAbs(basis, 0.95));
-    }
-    if (o.design && !scene->design.empty()) {
-      auto a = actorOf(designGrid(scene->design), kDesignBlue);
-      a->GetProperty()->SetLineWidth(1.5f);
-      a->GetProperty()->SetOpacity(dev ? 0.5 : 1.0);
-      a->PickableOff();
-      flat(a);
-      m.add(a);
-    }
-    if (o.surface && !scene->surface.empty()) {
-      auto poly = meshPoly(scene->surface);
-      auto a = actorOf(poly, kFlyingRed);
-      if (dev && scene->surface_deviation_m.size() == scene->surface.vertices.size()) {
-        attachScalars(poly, scene->surface_deviation_m, 1000.0, "deviation_mm");
-        useScalars(a, m.deviation_lut, -m.limit_mm, m.limit_mm);
-      }
-      // Pushed back a little so section curves and the design grid lying on it stay visible.
-      vtkPolyDataMapper::SafeDownCast(a->GetMapper())->SetRelativeCoincidentTopologyPolygonOffsetParameters(2, 2);
-      a->GetProperty()->SetInterpolationToPhong();
-      a->GetProperty()->SetSpecular(0.25);
-      a->GetProperty()->SetSpecularPower(20);
-      a->GetProperty()->SetAmbient(0.25);
-      m.add(a);
-      m.picker->AddPickList(a);
-      m.pickables.push_back({a, &scene->surface_deviation_m, "flying surface"});
-    }
-    if (o.cloud && !scene->raw_cloud.empty()) {
-      auto poly = pointPoly(scene->raw_cloud.points);
-      auto a = actorOf(poly, {1.0f, 0.35f, 0.30f});
-      if (dev && scene->raw_deviation_m.size() == scene->raw_cloud.size()) {
-        attachScalars(poly, scene->raw_deviation_m, 1000.0, "deviation_mm");
-        useScalars(a, m.deviation_lut, -m.limit_mm, m.limit_mm);
-      }
-      a->GetProperty()->SetPointSize(o.point_size);
-      flat(a);
-      m.add(a);
-      m.picker->AddPickList(a);
-      m.pickables.push_back({a, &scene->raw_deviation_m, "stored cloud"});
-    }
-    if (o.cluster && scene->analysis && !scene->analysis->sail_cloud.empty()) {
-      const Cloud& sail = scene->analysis->sail_cloud;
-      auto poly = pointPoly(sail.points);
-      auto a = actorOf(poly, kClusterGreen);
-      if (dev && scene->cluster_deviation_m.size() == sail.size()) {
-        attachScalars(poly, scene->cluster_deviation_m, 1000.0, "deviation_mm");
-        useScalars(a, m.deviation_lut, -m.limit_mm, m.limit_mm);
-      }
-      a->GetProperty()->SetPointSize(o.point_size + 1);
-      flat(a);
-      m.add(a);
-      m.picker->AddPickList(a);
-      m.pickables.push_back({a, &scene->cluster_deviation_m, "sail cluster"});
-    }
-    if (o.sections) {
-      std::vector<const std::vector<Vec3>*> curves;
-      for (const auto& s : scene->sections.sections) curves.push_back(&s.curve);
-      auto a = actorOf(curvePoly(curves), kSectionAmber);
-      a->GetProperty()->SetLineWidth(3.0f);
-      a->PickableOff();
-      flat(a);
-      m.add(a);
-    }
-    if (o.design_sections && !scene->design_sections.sections.empty()) {
-      std::vector<const std::vector<Vec3>*> curves;
-      for (const auto& s : scene->design_sections.sections) curves.push_back(&s.curve);
-      auto a = actorOf(curvePoly(curves), kDesignSectionBlue);
-      a->GetProperty()->SetLineWidth(2.5f);
-      a->PickableOff();
-      flat(a);
-      m.add(a);
-    }
-    if (o.section_planes && !scene->sections.sections.empty()) {
-      const SectionAnalysis& planes = scene->analysis ? scene->analysis->sections : scene->sections;
-      auto a = actorOf(planePoly(planes), {0.9f, 0.9f, 0.95f});
-      a->GetProperty()->SetOpacity(0.18);
-      a->PickableOff();
-      m.add(a);
-    }
-    m.scalar_bar->SetVisibility(dev);
-    if (dev) m.deviation_lut->SetTableRange(-m.limit_mm, m.limit_mm);
-  } else {
-    m.scalar_bar->SetVisibility(false);
-  }
+  if (scene) addSceneLayers(*scene, o);
+  else m.scalar_bar->SetVisibility(false);
+  addOverlays(overlays, o);
+  if (processing && !processing->cloud.empty()) addProcessingLayer(*processing, o);
 
+  if (!m.camera_placed && !m.props.empty()) {
+    setCamera(CameraPreset::ThreeQuarter);
+    m.camera_placed = true;
+  }
+  m.renderer->ResetCameraClippingRange();
+}
+
+void VtkViewport::addSceneLayers(const ScanScene& scene, const ViewOptions& o) {
+  Impl& m = *impl_;
+  const bool dev = o.deviation && (!scene.surface_deviation_m.empty() || !scene.raw_deviation_m.empty());
+  if (dev) {
+    const auto& basis = scene.surface_deviation_m.empty() ? scene.raw_deviation_m : scene.surface_deviation_m;
+    m.limit_mm = o.deviation_range_mm > 0 ? o.deviation_range_mm : std::max(1.0, 1000.0 * percentileAbs(basis, 0.95));
+  }
+  if (o.design && !scene.design.empty()) {
+    auto a = actorOf(designGrid(scene.design), kDesignBlue);
+    a->GetProperty()->SetLineWidth(1.5f);
+    a->GetProperty()->SetOpacity(dev ? 0.5 : 1.0);
+    a->PickableOff();
+    flat(a);
+    m.add(a);
+  }
+  if (o.surface && !scene.surface.empty()) {
+    auto poly = meshPoly(scene.surface);
+    auto a = actorOf(poly, kFlyingRed);
+    if (dev && scene.surface_deviation_m.size() == scene.surface.vertices.size()) {
+      attachScalars(poly, scene.surface_deviation_m, 1000.0, "deviation_mm");
+      useScalars(a, m.deviation_lut, -m.limit_mm, m.limit_mm);
+    }
+    // Pushed back a little so section curves and the design grid lying on it stay visible.
+    vtkPolyDataMapper::SafeDownCast(a->GetMapper())->SetRelativeCoincidentTopologyPolygonOffsetParameters(2, 2);
+    a->GetProperty()->SetInterpolationToPhong();
+    a->GetProperty()->SetSpecular(0.25);
+    a->GetProperty()->SetSpecularPower(20);
+    a->GetProperty()->SetAmbient(0.25);
+    m.add(a);
+    m.picker->AddPickList(a);
+    m.pickables.push_back({a, &scene.surface_deviation_m, "flying surface"});
+  }
+  if (o.cloud && !scene.raw_cloud.empty()) {
+    auto poly = pointPoly(scene.raw_cloud.points);
+    auto a = actorOf(poly, {1.0f, 0.35f, 0.30f});
+    if (dev && scene.raw_deviation_m.size() == scene.raw_cloud.size()) {
+      attachScalars(poly, scene.raw_deviation_m, 1000.0, "deviation_mm");
+      useScalars(a, m.deviation_lut, -m.limit_mm, m.limit_mm);
+    }
+    a->GetProperty()->SetPointSize(o.point_size);
+    flat(a);
+    m.add(a);
+    m.picker->AddPickList(a);
+    m.pickables.push_back({a, &scene.raw_deviation_m, "stored cloud"});
+  }
+  if (o.cluster && scene.analysis && !scene.analysis->sail_cloud.empty()) {
+    const Cloud& sail = scene.analysis->sail_cloud;
+    auto poly = pointPoly(sail.points);
+    auto a = actorOf(poly, kClusterGreen);
+    if (dev && scene.cluster_deviation_m.size() == sail.size()) {
+      attachScalars(poly, scene.cluster_deviation_m, 1000.0, "deviation_mm");
+      useScalars(a, m.deviation_lut, -m.limit_mm, m.limit_mm);
+    }
+    a->GetProperty()->SetPointSize(o.point_size + 1);
+    flat(a);
+    m.add(a);
+    m.picker->AddPickList(a);
+    m.pickables.push_back({a, &scene.cluster_deviation_m, "sail cluster"});
+  }
+  if (o.sections) {
+    std::vector<const std::vector<Vec3>*> curves;
+    for (const auto& s : scene.sections.sections) curves.push_back(&s.curve);
+    auto a = actorOf(curvePoly(curves), kSectionAmber);
+    a->GetProperty()->SetLineWidth(3.0f);
+    a->PickableOff();
+    flat(a);
+    m.add(a);
+  }
+  if (o.design_sections && !scene.design_sections.sections.empty()) {
+    std::vector<const std::vector<Vec3>*> curves;
+    for (const auto& s : scene.design_sections.sections) curves.push_back(&s.curve);
+    auto a = actorOf(curvePoly(curves), kDesignSectionBlue);
+    a->GetProperty()->SetLineWidth(2.5f);
+    a->PickableOff();
+    flat(a);
+    m.add(a);
+  }
+  if (o.section_planes && !scene.sections.sections.empty()) {
+    const SectionAnalysis& planes = scene.analysis ? scene.analysis->sections : scene.sections;
+    auto a = actorOf(planePoly(planes), {0.9f, 0.9f, 0.95f});
+    a->GetProperty()->SetOpacity(0.18);
+    a->PickableOff();
+    m.add(a);
+  }
+  m.scalar_bar->SetVisibility(dev);
+  if (dev) m.deviation_lut->SetTableRange(-m.limit_mm, m.limit_mm);
+}
+
+void VtkViewport::addOverlays(const std::vector<Overlay>& overlays, const ViewOptions& o) {
+  Impl& m = *impl_;
   for (const Overlay& ov : overlays) {
     if (!ov.scene) continue;
     if (!ov.scene->surface.empty()) {
@@ -422,37 +435,32 @@ void VtkViewport::setScene(const ScanScene* scene, const std::vector<Overlay>& o
     flat(c);
     m.add(c);
   }
+}
 
-  if (processing && !processing->cloud.empty()) {
-    auto poly = pointPoly(processing->cloud.points);
-    auto a = actorOf(poly, {0.85f, 0.85f, 0.85f});
-    if (processing->scalar.size() == processing->cloud.size()) {
-      attachScalars(poly, processing->scalar, 1.0, processing->scalar_name.c_str());
-      double lo = INFINITY, hi = -INFINITY;
-      for (double v : processing->scalar) {
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-      }
-      if (processing->scalar_name == "curvature") hi = std::min(hi, 0.05);  // flat sails sit near 0; edges saturate
-      useScalars(a, m.scalar_lut, lo, std::max(hi, lo + 1e-9));
+void VtkViewport::addProcessingLayer(const StageResult& processing, const ViewOptions& o) {
+  Impl& m = *impl_;
+  auto poly = pointPoly(processing.cloud.points);
+  auto a = actorOf(poly, {0.85f, 0.85f, 0.85f});
+  if (processing.scalar.size() == processing.cloud.size()) {
+    attachScalars(poly, processing.scalar, 1.0, processing.scalar_name.c_str());
+    double lo = INFINITY, hi = -INFINITY;
+    for (double v : processing.scalar) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
     }
-    a->GetProperty()->SetPointSize(o.point_size);
-    a->PickableOff();
-    flat(a);
-    m.add(a);
-    if (processing->analysis && !processing->analysis->mesh.empty()) {
-      auto s = actorOf(meshPoly(processing->analysis->mesh), {0.95f, 0.45f, 0.15f});
-      s->GetProperty()->SetOpacity(0.8);
-      s->PickableOff();
-      m.add(s);
-    }
+    if (processing.scalar_name == "curvature") hi = std::min(hi, 0.05);  // flat sails sit near 0; edges saturate
+    useScalars(a, m.scalar_lut, lo, std::max(hi, lo + 1e-9));
   }
-
-  if (!m.camera_placed && !m.props.empty()) {
-    setCamera(CameraPreset::ThreeQuarter);
-    m.camera_placed = true;
+  a->GetProperty()->SetPointSize(o.point_size);
+  a->PickableOff();
+  flat(a);
+  m.add(a);
+  if (processing.analysis && !processing.analysis->mesh.empty()) {
+    auto s = actorOf(meshPoly(processing.analysis->mesh), {0.95f, 0.45f, 0.15f});
+    s->GetProperty()->SetOpacity(0.8);
+    s->PickableOff();
+    m.add(s);
   }
-  m.renderer->ResetCameraClippingRange();
 }
 
 void VtkViewport::setCamera(CameraPreset preset) {

@@ -78,6 +78,12 @@ class VtkViewport {
   double deviationLimitMm() const;
 
  private:
+  // setScene's layers: the scene's own (design, surface, clouds, sections), the
+  // overlaid scans', and a processing stage's points.
+  void addSceneLayers(const ScanScene& scene, const ViewOptions& options);
+  void addOverlays(const std::vector<Overlay>& overlays, const ViewOptions& options);
+  void addProcessingLayer(const StageResult& processing, const ViewOptions& options);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
