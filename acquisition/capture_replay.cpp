@@ -11,6 +11,34 @@
 
 namespace sailshape {
 
+namespace {
+
+std::string plural(uint64_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+// One line for every damaged frame and stray byte the stream decoders passed over while looking for the
+// next frame start (both directions together), or "" when they passed over nothing.
+std::string skippedWarning(const ColaStreamStats& to, const ColaStreamStats& from) {
+  const uint64_t bad_length = to.bad_length + from.bad_length, bad_checksum = to.bad_checksum + from.bad_checksum;
+  const uint64_t unterminated = to.unterminated + from.unterminated;
+  const uint64_t frames = bad_length + bad_checksum + unterminated, bytes = to.garbage_bytes + from.garbage_bytes;
+  if (frames == 0 && bytes == 0) return {};
+  std::string why;
+  const auto add = [&](uint64_t n, const char* one, const char* many) {
+    if (n == 0) return;
+    why += why.empty() ? "" : ", ";
+    why += plural(n, one, many);
+  };
+  add(bad_length, "with a bad length field", "with a bad length field");
+  add(bad_checksum, "with a bad checksum", "with a bad checksum");
+  add(unterminated, "cut short", "cut short");
+  return "skipped " + plural(frames, "damaged frame", "damaged frames") + (why.empty() ? "" : " (" + why + ")") +
+         " and " + plural(bytes, "byte", "bytes") + " in all, resuming at the next frame start each time";
+}
+
+}  // namespace
+
 ReplayResult replayCapture(const std::string& path, const Progress& progress) {
   progress("read capture", 0.0);
   const Capture capture = readCapture(path);
@@ -22,6 +50,8 @@ ReplayResult replayCapture(const std::string& path, const Progress& progress) {
   out.warnings = capture.warnings;
   out.to_device = telegrams.to_device;
   out.from_device = telegrams.from_device;
+  if (std::string skipped = skippedWarning(out.to_device, out.from_device); !skipped.empty())
+    out.warnings.push_back(std::move(skipped));
   const size_t n = telegrams.telegrams.size();
   for (size_t i = 0; i < n; ++i) {
     const CapturedTelegram& t = telegrams.telegrams[i];

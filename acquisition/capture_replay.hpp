@@ -27,7 +27,9 @@ struct ReplayResult {
   std::map<std::string, size_t> other_telegrams;    // "sRN FirmwareVersion" -> count, both directions
   size_t undecodable = 0;                           // LMDscandata frames with a good checksum that did not decode
   ColaStreamStats to_device, from_device;
-  std::vector<std::string> warnings;                // from reading the capture and from undecodable frames
+  // From reading the capture, one line for the damaged frames and bytes skipped (the decoders resume at
+  // the next frame start, so every good frame is kept), and from undecodable frames.
+  std::vector<std::string> warnings;
 };
 
 // Reads and decodes `path` (either capture format). Throws FileError as readCapture does; bad frames are

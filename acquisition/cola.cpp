@@ -32,6 +32,25 @@ std::string printable(std::string_view text) {
   return out;
 }
 
+// Offset of the first complete, well-formed CoLa B frame in `view` at or after `from`: start marker, a
+// length of 1..max_payload, the bytes all there, the checksum matching and a payload that begins as a
+// telegram does ('s' and two letters). npos when there is none (yet).
+size_t completeFrameAt(std::string_view view, size_t from, size_t max_payload) {
+  const std::string_view stx(kBinaryStx, 4);
+  for (size_t at = view.find(stx, from); at != std::string_view::npos; at = view.find(stx, at + 1)) {
+    if (view.size() - at < kBinaryHeader) return std::string_view::npos;
+    uint32_t length = 0;
+    for (size_t i = 4; i < 8; ++i) length = (length << 8) | static_cast<unsigned char>(view[at + i]);
+    if (length < 3 || length > max_payload || view.size() - at < kBinaryHeader + length + 1) continue;
+    const std::string_view payload = view.substr(at + kBinaryHeader, length);
+    if (payload[0] != 's' || !std::isalpha(static_cast<unsigned char>(payload[1])) ||
+        !std::isalpha(static_cast<unsigned char>(payload[2])))
+      continue;
+    if (colaChecksum(payload) == static_cast<unsigned char>(view[at + kBinaryHeader + length])) return at;
+  }
+  return std::string_view::npos;
+}
+
 }  // namespace
 
 const char* colaDialectName(ColaDialect dialect) { return dialect == ColaDialect::kBinary ? "binary" : "ascii"; }
@@ -372,7 +391,17 @@ std::optional<std::string> ColaStreamDecoder::nextBinary() {
       skip(1, true);
       continue;
     }
-    if (view.size() < kBinaryHeader + length + 1) return std::nullopt;
+    if (view.size() < kBinaryHeader + length + 1) {
+      // Not all here yet, or a damaged length field announces more than the frame holds. A complete good
+      // frame starting inside the announced span settles it: this one is damaged. Skip to that frame's
+      // start instead of waiting for bytes that would swallow it and every frame after it (to the end of
+      // a capture, or for up to max_payload_bytes on a live stream).
+      const size_t next_frame = completeFrameAt(view, 1, params_.max_payload_bytes);
+      if (next_frame == std::string_view::npos) return std::nullopt;
+      ++stats_.bad_length;
+      skip(next_frame, true);
+      continue;
+    }
     const std::string_view payload = view.substr(kBinaryHeader, length);
     if (colaChecksum(payload) != static_cast<unsigned char>(view[kBinaryHeader + length])) {
       ++stats_.bad_checksum;

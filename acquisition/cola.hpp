@@ -130,7 +130,8 @@ struct ColaDecoderParams {
 struct ColaStreamStats {
   uint64_t frames = 0;             // good frames returned by next()
   uint64_t bad_checksum = 0;       // CoLa B frames whose XOR did not match: dropped
-  uint64_t bad_length = 0;         // CoLa B length 0 or over max_payload_bytes: start marker skipped
+  uint64_t bad_length = 0;         // CoLa B length 0, over max_payload_bytes, or running past the start of a
+                                   // complete good frame: skipped up to the next start marker or that frame
   uint64_t unterminated = 0;       // CoLa A frames cut by a new STX or longer than the limit: dropped
   uint64_t garbage_bytes = 0;      // bytes skipped while looking for a start marker (incl. a dropped frame's)
 };
@@ -140,6 +141,9 @@ struct ColaStreamStats {
 // - garbage before or between frames is skipped up to the next start marker and counted;
 // - a CoLa B frame with a bad checksum is dropped and counted, and the search restarts one byte after its
 //   start marker, so a good frame that the bogus length had covered is still found;
+// - a CoLa B frame whose length field announces more bytes than have come is not waited for once a
+//   complete good frame (checksum matching, payload starting as a telegram) has come after its start: it
+//   counts as a bad length and decoding resumes at that frame;
 // - a frame split across feeds waits for the rest; nothing is returned twice or lost.
 class ColaStreamDecoder {
  public:

@@ -7,10 +7,12 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <iterator>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -25,10 +27,22 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// SOPAS error numbers sent in sFA replies.
-constexpr uint16_t kErrAccessDenied = 1;
-constexpr uint16_t kErrUnknownName = 2;
-constexpr uint16_t kErrBadArguments = 4;
+// SOPAS error numbers sent in sFA replies, as SICK's driver names them (sick_scan_xd, SopasBase's
+// convertSopasErrorCodeToText).
+constexpr uint16_t kErrMethodAccessDenied = 1;  // METHODIN_ACCESSDENIED: a method that needs a login
+constexpr uint16_t kErrUnknownMethod = 2;       // METHODIN_UNKNOWNINDEX
+constexpr uint16_t kErrUnknownVariable = 3;     // VARIABLE_UNKNOWNINDEX (what the LMS511 answers an unknown sRN)
+constexpr uint16_t kErrLocalCondition = 4;      // LOCALCONDITIONFAILED: a value outside what the device accepts
+constexpr uint16_t kErrInvalidData = 5;         // INVALID_DATA: arguments missing or not parsable
+constexpr uint16_t kErrWriteAccessDenied = 10;  // VARIABLE_WRITE_ACCESSDENIED: a write that needs a login
+constexpr uint16_t kErrUnknownCommand = 12;     // UNKNOWN_COLA_COMMAND: a type other than sRN, sWN, sMN, sEN
+constexpr uint16_t kErrUnknownEvent = 15;       // EVENTREG_UNKNOWNINDEX
+
+// "sFA" + u16 code (CoLa B) or "sFA <code>" (CoLa A, hex like every number there).
+std::string sopasError(bool binary, uint16_t code) {
+  return "sFA" + (binary ? ColaWriter(ColaDialect::kBinary).u16(code).bytes()
+                         : " " + ColaWriter(ColaDialect::kAscii).u16(code).bytes());
+}
 
 std::vector<uint8_t> hexBytes(const char* hex) {
   std::vector<uint8_t> out;
@@ -49,10 +63,15 @@ int64_t roundToInt(double v) { return static_cast<int64_t>(std::llround(v)); }
 }  // namespace
 
 struct ScannerEmulator::Session {
-  // Device configuration (kept across connections, as on a real device).
-  uint32_t frequency = 2500;     // 1/100 Hz
-  uint32_t resolution = 1667;    // 1/10000°
+  // Device configuration (kept across connections, as on a real device). Angles in 1/10000°.
+  // The scan configuration (LMPscancfg, set by mLMPsetscancfg): frequency in 1/100 Hz, step, and the one
+  // sector the mirror measures over.
+  uint32_t frequency = 2500;
+  uint32_t resolution = 1667;
+  int32_t sector_start = -50000, sector_stop = 1850000;
+  // The output range (LMPoutputRange): the part of the sector LMDscandata carries, at the scan's step.
   int32_t start = -50000, stop = 1850000;
+  uint8_t echo_filter = 0;  // FREchoFilter (LMS5xx): 0 first echo, 1 all echoes, 2 last echo
   bool remission = true, encoder = false, time_block = false;
   std::string scandatacfg_args;  // as last written, echoed by sRN LMDscandatacfg
   // Per connection.
@@ -74,8 +93,8 @@ ScannerEmulator::ScannerEmulator(const Scene& scene, const ScannerEmulatorParams
   const ScannerSpec spec = sensor_.spec();
   session_->frequency = static_cast<uint32_t>(std::lround(spec.default_frequency_hz * 100));
   session_->resolution = static_cast<uint32_t>(std::lround(spec.default_resolution_deg * 10000));
-  session_->start = static_cast<int32_t>(std::lround(spec.first_angle_deg * 10000));
-  session_->stop = static_cast<int32_t>(std::lround(spec.last_angle_deg * 10000));
+  session_->start = session_->sector_start = static_cast<int32_t>(std::lround(spec.first_angle_deg * 10000));
+  session_->stop = session_->sector_stop = static_cast<int32_t>(std::lround(spec.last_angle_deg * 10000));
   session_->remission = params.sensor.model == ScannerModel::Lms511;
 
   listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
@@ -172,13 +191,7 @@ void ScannerEmulator::runSession(int fd) {
       }
       while (auto payload = decoder->next()) {
         if (params_.mute) continue;
-        std::string out;
-        try {
-          out = reply(*payload, binary);
-        } catch (const ColaError&) {
-          out = binary ? std::string("sFA") + ColaWriter(ColaDialect::kBinary).u16(kErrBadArguments).bytes()
-                       : "sFA " + std::to_string(kErrBadArguments);
-        }
+        const std::string out = reply(*payload, binary);
         if (!out.empty() && !sendAll(frameCola(binary ? ColaDialect::kBinary : ColaDialect::kAscii, out))) return;
       }
     }
@@ -284,10 +297,7 @@ struct ScannerEmulator::Request {
         w(dialect) {}
   std::string out(const char* type, const ColaWriter& writer) const { return colaPayload(type, t.name, writer.bytes()); }
   std::string bare(const char* type) const { return std::string(type) + " " + t.name + " "; }
-  std::string fail(uint16_t code) const {
-    return binary ? std::string("sFA") + ColaWriter(ColaDialect::kBinary).u16(code).bytes()
-                  : "sFA " + std::to_string(code);
-  }
+  std::string fail(uint16_t code) const { return sopasError(binary, code); }
   bool binary;
   ColaDialect dialect;
   ColaTelegram t;
@@ -296,12 +306,16 @@ struct ScannerEmulator::Request {
 };
 
 std::string ScannerEmulator::reply(const std::string& request, bool binary) {
-  Request r(request, binary);
-  if (r.t.type == "sMN") return replyMethod(r);
-  if (r.t.type == "sRN") return replyRead(r);
-  if (r.t.type == "sWN") return replyWrite(r);
-  if (r.t.type == "sEN") return replyEvent(r);
-  return r.fail(kErrUnknownName);
+  try {
+    Request r(request, binary);
+    if (r.t.type == "sMN") return replyMethod(r);
+    if (r.t.type == "sRN") return replyRead(r);
+    if (r.t.type == "sWN") return replyWrite(r);
+    if (r.t.type == "sEN") return replyEvent(r);
+    return r.fail(kErrUnknownCommand);
+  } catch (const ColaError&) {  // not a telegram, or arguments missing or unreadable
+    return sopasError(binary, kErrInvalidData);
+  }
 }
 
 // sMN: log in, start and stop measuring, scan configuration.
@@ -322,7 +336,10 @@ std::string ScannerEmulator::replyMethod(Request& r) {
     s.running = true;
     return r.out("sAN", r.w.u8(1));
   }
-  if (s.access_level < 2) return r.fail(kErrAccessDenied);
+  static const char* const kMethods[] = {"LMCstartmeas", "LMCstopmeas", "mLMPsetscancfg"};
+  if (std::find(std::begin(kMethods), std::end(kMethods), r.t.name) == std::end(kMethods))
+    return r.fail(kErrUnknownMethod);
+  if (s.access_level < 2) return r.fail(kErrMethodAccessDenied);
   if (r.t.name == "LMCstartmeas") {
     if (!s.measuring) {
       s.stream_start = std::max(Clock::now(), ready_at_);  // a starting device streams nothing yet
@@ -335,7 +352,7 @@ std::string ScannerEmulator::replyMethod(Request& r) {
     s.measuring = false;
     return r.out("sAN", r.w.u8(0));
   }
-  if (r.t.name == "mLMPsetscancfg") {
+  {  // mLMPsetscancfg
     const uint32_t f = r.in.u32("scan frequency");
     r.in.u16("sectors");
     const uint32_t res = r.in.u32("angular resolution");
@@ -354,12 +371,14 @@ std::string ScannerEmulator::replyMethod(Request& r) {
     if (status == 0) {
       s.frequency = f;
       s.resolution = res;
+      s.sector_start = start;
+      s.sector_stop = stop;
+      // The output range cannot reach beyond what the mirror measures: it becomes the new sector.
       s.start = start;
       s.stop = stop;
     }
-    return r.out("sAN", r.w.u8(status).u32(s.frequency).u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
+    return r.out("sAN", r.w.u8(status).u32(s.frequency).u16(1).u32(s.resolution).i32(s.sector_start).i32(s.sector_stop));
   }
-  return r.fail(kErrUnknownName);
 }
 
 // sRN: device facts and configuration as the recorded devices answered, and a polled scan.
@@ -378,7 +397,11 @@ std::string ScannerEmulator::replyRead(Request& r) {
                                                : lms111           ? 18090362u
                                                                   : 18110550u)));
   if (r.t.name == "LMPoutputRange") return r.out("sRA", r.w.u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
-  if (r.t.name == "LMPscancfg") return r.out("sRA", r.w.u32(s.frequency).u16(1).u32(s.resolution).i32(s.start).i32(s.stop));
+  // Scan frequency, active sectors (one), then per sector its step, start and stop (LMS1xx/5xx telegram
+  // listing; sick_scan_xd reads it as "%4y%2y%4y%4y%4y").
+  if (r.t.name == "LMPscancfg")
+    return r.out("sRA", r.w.u32(s.frequency).u16(1).u32(s.resolution).i32(s.sector_start).i32(s.sector_stop));
+  if (r.t.name == "FREchoFilter" && !lms111) return r.out("sRA", r.w.u8(s.echo_filter));
   if (r.t.name == "LMDscandatacfg") {
     if (!s.scandatacfg_args.empty()) return colaPayload("sRA", r.t.name, s.scandatacfg_args);
     return r.out("sRA", r.w.u8(1).u8(0).u8(s.remission).u8(0).u8(0).u8(s.encoder ? 1 : 0).u8(0).u8(0).u8(0).u8(0)
@@ -400,28 +423,57 @@ std::string ScannerEmulator::replyRead(Request& r) {
     const double period_s = 100.0 / s.frequency;
     return scanPayload(r.binary, true, Clock::now() - std::chrono::microseconds(roundToInt(period_s * 1e6)));
   }
-  return r.fail(kErrUnknownName);
+  return r.fail(kErrUnknownVariable);
 }
 
-// sWN: the CoLa dialect, output range and scan data contents.
+// sWN: the CoLa dialect, output range, scan data contents, echo filter and the encoder input.
 std::string ScannerEmulator::replyWrite(Request& r) {
   Session& s = *session_;
+  const bool lms111 = params_.sensor.model == ScannerModel::Lms111;
   if (r.t.name == "EIHstCola") return r.bare("sWA");
-  if (s.access_level < 2) return r.fail(kErrAccessDenied);
+  // FREchoFilter and DO3And4Fnc (inputs 3 and 4 as the encoder's) exist on the LMS5xx only; SICK's driver
+  // sends neither to an LMS1xx.
+  static const char* const kVariables[] = {"LMPoutputRange", "LMDscandatacfg", "LICsrc", "LICencset", "LICencres"};
+  const bool lms5xx_only = r.t.name == "FREchoFilter" || r.t.name == "DO3And4Fnc";
+  if ((lms5xx_only && lms111) ||
+      (!lms5xx_only && std::find(std::begin(kVariables), std::end(kVariables), r.t.name) == std::end(kVariables)))
+    return r.fail(kErrUnknownVariable);
+  if (s.access_level < 2) return r.fail(kErrWriteAccessDenied);
+  if (r.t.name == "FREchoFilter") {
+    const uint8_t filter = r.in.u8("echo filter");
+    if (filter > 2) return r.fail(kErrLocalCondition);
+    s.echo_filter = filter;
+    return r.bare("sWA");
+  }
+  // The encoder settings SICK's driver writes when asked for an encoder (encoder_mode ≥ 0): increment
+  // source (0 fixed speed, 1 encoder), encoder mode (0 off, 1 single increment, 2 and 3 with direction),
+  // resolution (float, mm per tick) and inputs 3/4 as the encoder's. Scans carry the turntable's encoder
+  // block whatever they say (LMDscandatacfg asks for it).
+  if (r.t.name == "LICsrc" || r.t.name == "DO3And4Fnc") {
+    if (r.in.u8("setting") > 1) return r.fail(kErrLocalCondition);
+    return r.bare("sWA");
+  }
+  if (r.t.name == "LICencset") {
+    if (r.in.u8("encoder mode") > 3) return r.fail(kErrLocalCondition);
+    return r.bare("sWA");
+  }
+  if (r.t.name == "LICencres") {
+    r.in.f32("resolution");
+    return r.bare("sWA");
+  }
   if (r.t.name == "LMPoutputRange") {
     r.in.u16("sectors");
     const uint32_t res = r.in.u32("angular resolution");
     const int32_t start = r.in.i32("start angle");
     const int32_t stop = r.in.i32("stop angle");
-    const ScannerSpec spec = sensor_.spec();
-    if (res != s.resolution || !(start >= spec.first_angle_deg * 10000 && stop <= spec.last_angle_deg * 10000 &&
-                                 start < stop))
-      return r.fail(kErrBadArguments);
+    // Within the measured sector, at its step.
+    if (res != s.resolution || !(start >= s.sector_start && stop <= s.sector_stop && start < stop))
+      return r.fail(kErrLocalCondition);
     s.start = start;
     s.stop = stop;
     return r.bare("sWA");
   }
-  if (r.t.name == "LMDscandatacfg") {
+  {  // LMDscandatacfg
     // Two-byte fields go as byte pairs ("1 0" in CoLa A), as SICK's driver writes them.
     const uint8_t channel = r.in.u8("output channel");
     r.in.u8("output channel (second byte)");
@@ -435,19 +487,20 @@ std::string ScannerEmulator::replyWrite(Request& r) {
     r.in.u8("comment");
     const uint8_t time = r.in.u8("time");
     r.in.u16("output interval");
-    if (channel == 0 || resolution > 1) return r.fail(kErrBadArguments);
+    if (channel == 0 || resolution > 1) return r.fail(kErrLocalCondition);
     s.remission = remission != 0;
     s.encoder = encoder != 0;
     s.time_block = time != 0;
     s.scandatacfg_args = r.t.arguments;
     return r.bare("sWA");
   }
-  return r.fail(kErrUnknownName);
 }
 
 // sEN: subscriptions; only LMDscandata streams anything.
 std::string ScannerEmulator::replyEvent(Request& r) {
   Session& s = *session_;
+  if (r.t.name != "LMDscandata" && r.t.name != "LFErec" && r.t.name != "LIDoutputstate" && r.t.name != "LIDinputstate")
+    return r.fail(kErrUnknownEvent);
   const uint8_t on = r.in.u8("enable");
   if (r.t.name == "LMDscandata") {
     if (on && !s.streaming) {
@@ -455,8 +508,6 @@ std::string ScannerEmulator::replyEvent(Request& r) {
       s.next_scan = 0;
     }
     s.streaming = on != 0;
-  } else if (r.t.name != "LFErec" && r.t.name != "LIDoutputstate" && r.t.name != "LIDinputstate") {
-    return r.fail(kErrUnknownName);
   }
   return r.out("sEA", r.w.u8(on));
 }

@@ -59,8 +59,8 @@ class ScannerEmulator {
   uint64_t connections() const { return connections_; }
 
   // The reply payloads (unframed) to one request payload in `binary` or ASCII; what a connection gets.
-  // Public so tests can check replies telegram by telegram. An unknown request, or one that needs a login
-  // first, gets an sFA error reply.
+  // Public so tests can check replies telegram by telegram. An unknown request, one that needs a login
+  // first or one with bad arguments gets an sFA error reply (codes as SICK's driver reads them, README).
   std::string reply(const std::string& request_payload, bool binary);
 
  private:

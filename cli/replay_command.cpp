@@ -43,9 +43,10 @@ void run(const ReplayOptions& o) {
     std::printf("\n");
   }
   const ColaStreamStats& s = r.from_device;
-  std::printf("from device: %llu frames, %llu bad checksum, %llu garbage bytes; %zu undecodable scans\n",
+  std::printf("from device: %llu frames, %llu bad checksum, %llu bad length, %llu garbage bytes; %zu undecodable scans\n",
               static_cast<unsigned long long>(s.frames), static_cast<unsigned long long>(s.bad_checksum),
-              static_cast<unsigned long long>(s.garbage_bytes), r.undecodable);
+              static_cast<unsigned long long>(s.bad_length), static_cast<unsigned long long>(s.garbage_bytes),
+              r.undecodable);
   for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (!o.json.empty()) {
     writeJsonFile(o.json, replayJson(r));

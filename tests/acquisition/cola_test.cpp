@@ -237,6 +237,42 @@ TEST(ColaStream, LengthOverTheLimitIsSkipped) {
   EXPECT_THROW(ColaStreamDecoder({ColaDialect::kBinary, 0}), ColaError);
 }
 
+// A damaged length field that announces more than its frame holds (still under the limit) is not waited
+// for once a complete good frame has come after it: the frames after it come out at once, whether the
+// bytes arrive together (a capture replayed) or one by one (a live stream).
+TEST(ColaStream, LengthRunningPastTheNextFrameIsSkippedToThatFrame) {
+  std::string damaged = frameCola(ColaDialect::kBinary, "sSN LMDscandata " + bytes({0, 1, 2, 3}));
+  damaged[6] = 0x7f;  // announces 0x7f00 + 21 bytes
+  const std::string b = frameCola(ColaDialect::kBinary, "sMN Run");
+  const std::string c = frameCola(ColaDialect::kBinary, "sAN Run " + bytes({1}));
+  ColaStreamDecoder whole;
+  whole.feed(damaged + b + c);
+  EXPECT_EQ(drain(whole), (std::vector<std::string>{"sMN Run", "sAN Run " + bytes({1})}));
+  EXPECT_EQ(whole.stats().bad_length, 1u);
+  EXPECT_EQ(whole.stats().bad_checksum, 0u);
+  EXPECT_EQ(whole.stats().garbage_bytes, damaged.size());
+  EXPECT_EQ(whole.bufferedBytes(), 0u);
+
+  ColaStreamDecoder trickle;
+  std::vector<std::string> got;
+  size_t fed = 0, first_at = 0;
+  for (char ch : damaged + b + c) {
+    trickle.feed(std::string(1, ch));
+    ++fed;
+    for (auto& p : drain(trickle)) {
+      if (got.empty()) first_at = fed;
+      got.push_back(p);
+    }
+  }
+  EXPECT_EQ(got, (std::vector<std::string>{"sMN Run", "sAN Run " + bytes({1})}));
+  EXPECT_EQ(first_at, damaged.size() + b.size());  // as soon as the good frame is complete
+  // A frame still arriving, with no good frame after its start, is waited for.
+  ColaStreamDecoder waiting;
+  waiting.feed(b.substr(0, b.size() - 1));
+  EXPECT_FALSE(waiting.next().has_value());
+  EXPECT_EQ(waiting.stats().bad_length, 0u);
+}
+
 TEST(ColaStream, PayloadHoldingStartMarkerBytesIsNotCut) {
   // The LMS111 answers LIDinputstate with 02 02 02 02 inside the payload.
   const std::string payload = "sRA LIDinputstate " + bytes({0, 1, 0, 0, 0, 0, 2, 2, 2, 2, 0, 0});

@@ -365,3 +365,157 @@ TEST(ScannerEmulator, BetaFollowsTheTurntable) {
   // Beam direction (cos α, sin α cos β, sin α sin β): z-component sin α sin(-60°).
   EXPECT_NEAR(scanRangeMm(*dist, i90) / 1000.0, 2.0 / (std::sin(alpha) * std::sin(60 * kRadPerDeg)), 0.0015);
 }
+
+namespace {
+
+// One request of SICK's driver sick_scan_xd 3.x as it sends it (driver/src/sick_scan_common.cpp: the
+// ASCII command, and what convertAscii2BinaryCmd makes of it for CoLa B), and the reply type a device gives.
+struct DriverRequest {
+  std::string ascii;   // payload in CoLa A, as the driver writes it
+  std::string binary;  // payload in CoLa B
+  std::string reply_type;
+};
+
+DriverRequest req(const std::string& type, const std::string& name, const std::string& ascii_args,
+                  const ColaWriter& binary_args, const std::string& reply_type) {
+  return {colaPayload(type, name, ascii_args), colaPayload(type, name, binary_args.bytes()), reply_type};
+}
+
+// sick_scan_xd's start-up for an LMS1xx or LMS5xx (one layer: no LMCstopmeas, no application switch),
+// with an encoder asked for (encoder_mode 2), through to streaming.
+std::vector<DriverRequest> driverStartup(ScannerModel model, ColaDialect dialect) {
+  const bool lms5xx = model == ScannerModel::Lms511;
+  const ColaWriter B(ColaDialect::kBinary);
+  const auto u8 = [&](uint8_t v) { return ColaWriter(B).u8(v); };
+  const ColaWriter login = ColaWriter(B).u8(3).u32(0xF4724744u);
+  std::vector<DriverRequest> out = {
+      req("sRN", "SCdevicestate", "", B, "sRA"),  // which dialect the device speaks
+      req("sMN", "SetAccessMode", "3 F4724744", login, "sAN"),
+      dialect == ColaDialect::kBinary ? req("sWN", "EIHstCola", "1", u8(1), "sWA") : req("sWN", "EIHstCola", "0", u8(0), "sWA"),
+      req("sRN", "FirmwareVersion", "", B, "sRA"),
+      req("sRN", "SCdevicestate", "", B, "sRA"),
+      req("sRN", "ODoprh", "", B, "sRA"),
+      req("sRN", "ODpwrc", "", B, "sRA"),
+      req("sRN", "LocationName", "", B, "sRA")};
+  if (lms5xx) out.push_back(req("sWN", "DO3And4Fnc", "1", u8(1), "sWA"));
+  out.push_back(req("sWN", "LICsrc", "1", u8(1), "sWA"));
+  out.push_back(req("sWN", "LICencset", "2", u8(2), "sWA"));
+  out.push_back(req("sWN", "LICencres", "3F800000", ColaWriter(B).f32(1.0f), "sWA"));
+  const int32_t first = lms5xx ? -50000 : -450000, last = lms5xx ? 1850000 : 2250000;
+  const uint32_t step = lms5xx ? 1667 : 5000, frequency = lms5xx ? 2500 : 5000;
+  const ColaWriter range = ColaWriter(B).u16(1).u32(step).i32(first).i32(last);
+  const ColaWriter range_a = ColaWriter(ColaDialect::kAscii).u16(1).u32(step).i32(first).i32(last);
+  out.push_back(req("sRN", "LMPoutputRange", "", B, "sRA"));
+  out.push_back(req("sWN", "LMPoutputRange", range_a.bytes(), range, "sWA"));
+  out.push_back(req("sRN", "LMPoutputRange", "", B, "sRA"));
+  const ColaWriter cfg = ColaWriter(B).u8(1).u8(0).u8(1).u8(1).u8(0).u8(1).u8(0).u8(0).u8(0).u8(0).u8(1).u16(1);
+  out.push_back(req("sWN", "LMDscandatacfg", "1 0 1 1 0 1 0 0 0 0 1 1", cfg, "sWA"));
+  out.push_back(req("sRN", "LMDscandatacfg", "", B, "sRA"));
+  if (lms5xx) {  // sendSopasRunSetAccessMode before the scan configuration
+    out.push_back(req("sMN", "Run", "", B, "sAN"));
+    out.push_back(req("sMN", "SetAccessMode", "3 F4724744", login, "sAN"));
+  }
+  const std::string scancfg_a = "+" + std::to_string(frequency) + " +1 +" + std::to_string(step) + " " +
+                                (first < 0 ? "-" : "+") + std::to_string(std::abs(first)) + " +" + std::to_string(last);
+  out.push_back(req("sMN", "mLMPsetscancfg", scancfg_a, ColaWriter(B).u32(frequency).u16(1).u32(step).i32(first).i32(last), "sAN"));
+  out.push_back(req("sRN", "LMPscancfg", "", B, "sRA"));
+  if (lms5xx) out.push_back(req("sWN", "FREchoFilter", "2", u8(2), "sWA"));
+  out.push_back(req("sMN", "LMCstartmeas", "", B, "sAN"));
+  out.push_back(req("sMN", "Run", "", B, "sAN"));
+  out.push_back(req("sEN", "LMDscandata", "1", u8(1), "sEA"));
+  return out;
+}
+
+void answersTheCurrentDriver(ScannerModel model, ColaDialect dialect) {
+  ScannerEmulator emu(wallScene(), params(model));
+  RawCola cola(emu.port(), dialect);
+  for (const DriverRequest& r : driverStartup(model, dialect)) {
+    const std::string& payload = dialect == ColaDialect::kBinary ? r.binary : r.ascii;
+    cola.send(payload);
+    const std::string reply = cola.next(3.0, "sSN");
+    ASSERT_FALSE(reply.empty()) << "no reply to " << payload;
+    const ColaTelegram q = splitColaTelegram(payload), a = splitColaTelegram(reply);
+    ASSERT_EQ(a.type, r.reply_type) << q.type << " " << q.name << " got '" << reply.substr(0, 40) << "'";
+    EXPECT_EQ(a.name, q.name);
+  }
+  const std::string scan = cola.next(3.0);
+  ASSERT_FALSE(scan.empty());
+  const ScanData d = decodeScanData(scan, dialect);
+  EXPECT_EQ(d.channel("DIST1")->values.size(), model == ScannerModel::Lms511 ? 1141u : 541u);
+  EXPECT_EQ(d.encoders.size(), 1u);
+}
+
+}  // namespace
+
+TEST(ScannerEmulator, Lms511AnswersTheCurrentDriversStartupInCoLaB) {
+  answersTheCurrentDriver(ScannerModel::Lms511, ColaDialect::kBinary);
+}
+TEST(ScannerEmulator, Lms511AnswersTheCurrentDriversStartupInCoLaA) {
+  answersTheCurrentDriver(ScannerModel::Lms511, ColaDialect::kAscii);
+}
+TEST(ScannerEmulator, Lms111AnswersTheCurrentDriversStartupInCoLaB) {
+  answersTheCurrentDriver(ScannerModel::Lms111, ColaDialect::kBinary);
+}
+TEST(ScannerEmulator, Lms111AnswersTheCurrentDriversStartupInCoLaA) {
+  answersTheCurrentDriver(ScannerModel::Lms111, ColaDialect::kAscii);
+}
+
+// An LMS5xx keeps its echo filter (0 first, 1 all, 2 last echo) and refuses others; the LMS1xx has none.
+TEST(ScannerEmulator, Lms511KeepsItsEchoFilter) {
+  ScannerEmulator emu(wallScene(), params(ScannerModel::Lms511));
+  EXPECT_EQ(emu.reply("sWN FREchoFilter 2", false), "sFA A");  // a write before the login
+  EXPECT_EQ(emu.reply("sMN SetAccessMode 3 F4724744", false), "sAN SetAccessMode 1");
+  EXPECT_EQ(emu.reply("sRN FREchoFilter", false), "sRA FREchoFilter 0");
+  EXPECT_EQ(emu.reply("sWN FREchoFilter 2", false), "sWA FREchoFilter ");
+  EXPECT_EQ(emu.reply("sRN FREchoFilter", false), "sRA FREchoFilter 2");
+  EXPECT_EQ(emu.reply("sWN FREchoFilter 3", false), "sFA 4");
+  EXPECT_EQ(emu.reply("sRN FREchoFilter", true), "sRA FREchoFilter " + std::string(1, '\x02'));
+  EXPECT_EQ(emu.reply("sWN FREchoFilter " + std::string(1, '\x01'), true), "sWA FREchoFilter ");
+  EXPECT_EQ(emu.reply("sRN FREchoFilter", true), "sRA FREchoFilter " + std::string(1, '\x01'));
+
+  ScannerEmulator lms111(wallScene(), params(ScannerModel::Lms111));
+  EXPECT_EQ(lms111.reply("sMN SetAccessMode 3 F4724744", false), "sAN SetAccessMode 1");
+  EXPECT_EQ(lms111.reply("sWN FREchoFilter 2", false), "sFA 3");
+  EXPECT_EQ(lms111.reply("sRN FREchoFilter", true), "sFA" + std::string("\x00\x03", 2));
+}
+
+// LMPscancfg is the scan configuration (frequency, sectors, step, sector start and stop), whatever the
+// output range: narrowing the output to 60°..120° leaves it at the sector mLMPsetscancfg set.
+TEST(ScannerEmulator, LmpScancfgAnswersTheScanConfigurationNotTheOutputRange) {
+  ScannerEmulator emu(wallScene(), params(ScannerModel::Lms511));
+  EXPECT_EQ(emu.reply("sMN SetAccessMode 3 F4724744", false), "sAN SetAccessMode 1");
+  EXPECT_EQ(emu.reply("sRN LMPscancfg", false), "sRA LMPscancfg 9C4 1 683 FFFF3CB0 1C3A90");  // 25 Hz, 0.1667°, -5°..185°
+  EXPECT_EQ(emu.reply("sMN mLMPsetscancfg +5000 +1 +5000 -50000 +1850000", false),
+            "sAN mLMPsetscancfg 0 1388 1 1388 FFFF3CB0 1C3A90");
+  EXPECT_EQ(emu.reply("sWN LMPoutputRange 1 1388 927C0 124F80", false), "sWA LMPoutputRange ");  // 60°..120°
+  EXPECT_EQ(emu.reply("sRN LMPoutputRange", false), "sRA LMPoutputRange 1 1388 927C0 124F80");
+  EXPECT_EQ(emu.reply("sRN LMPscancfg", false), "sRA LMPscancfg 1388 1 1388 FFFF3CB0 1C3A90");
+  const ColaWriter B(ColaDialect::kBinary);
+  EXPECT_EQ(emu.reply("sRN LMPscancfg", true),
+            colaPayload("sRA", "LMPscancfg", ColaWriter(B).u32(5000).u16(1).u32(5000).i32(-50000).i32(1850000).bytes()));
+  // The scans carry the output range: 60°..120° in 0.5° steps.
+  const ScanData d = decodeScanData(emu.reply("sRN LMDscandata", true), ColaDialect::kBinary);
+  EXPECT_EQ(d.channel("DIST1")->values.size(), 121u);
+  EXPECT_EQ(d.channel("DIST1")->start_angle, 600000);
+  // An output range beyond the measured sector is refused.
+  EXPECT_EQ(emu.reply("sMN mLMPsetscancfg +5000 +1 +5000 +300000 +1500000", false),
+            "sAN mLMPsetscancfg 0 1388 1 1388 493E0 16E360");
+  EXPECT_EQ(emu.reply("sWN LMPoutputRange 1 1388 0 124F80", false), "sFA 4");
+}
+
+// The error numbers of SICK's driver's table (sick_scan_xd SopasBase): 1 method access denied, 2 unknown
+// method, 3 unknown variable, 5 invalid data, 10 write access denied, 12 unknown command, 15 unknown event.
+TEST(ScannerEmulator, ErrorRepliesUseTheDriversSopasCodes) {
+  ScannerEmulator emu(wallScene(), params(ScannerModel::Lms511));
+  EXPECT_EQ(emu.reply("sRN NoSuchVariable", false), "sFA 3");
+  EXPECT_EQ(emu.reply("sRN NoSuchVariable", true), "sFA" + std::string("\x00\x03", 2));
+  EXPECT_EQ(emu.reply("sWN NoSuchVariable 1", false), "sFA 3");
+  EXPECT_EQ(emu.reply("sMN LMCstartmeas", false), "sFA 1");  // before the login
+  EXPECT_EQ(emu.reply("sWN LMPoutputRange 1 683 0 10000", false), "sFA A");
+  EXPECT_EQ(emu.reply("sMN mNoSuchMethod", false), "sFA 2");
+  EXPECT_EQ(emu.reply("sMN mNoSuchMethod", true), "sFA" + std::string("\x00\x02", 2));
+  EXPECT_EQ(emu.reply("sEN NoSuchEvent 1", false), "sFA F");
+  EXPECT_EQ(emu.reply("sXN Something", false), "sFA C");
+  EXPECT_EQ(emu.reply("sMN SetAccessMode 3 F4724744", false), "sAN SetAccessMode 1");
+  EXPECT_EQ(emu.reply("sWN LMPoutputRange 1 683", false), "sFA 5");  // start and stop missing
+}

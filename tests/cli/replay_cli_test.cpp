@@ -72,6 +72,80 @@ TEST_F(ReplayCli, RecordingToJsonKeepsTheRawValues) {
   EXPECT_EQ(doc["other_telegrams"]["sMN SetAccessMode"], 1);
 }
 
+// SICK's LMS511 recording with the length field of one LMDscandata frame damaged so that it announces more
+// than is left of the capture: that frame is skipped, the decoder resumes at the next frame start, every
+// other frame is replayed, and one warning line gives the count.
+TEST_F(ReplayCli, DamagedLengthFieldLosesOnlyItsFrame) {
+  nlohmann::json doc = nlohmann::json::parse(readText(kRecordings + "20210302_lms511.pcapng.json"));
+  std::vector<size_t> scan_segments;  // elements whose TCP segment is one sSN LMDscandata frame
+  const std::string scan_head = "73:53:4e:20:4c:4d:44";  // "sSN LMD" after the 8-byte header
+  for (size_t i = 0; i < doc.size(); ++i) {
+    const auto& tcp = doc[i]["_source"]["layers"]["tcp"];
+    if (tcp.contains("tcp.payload") && tcp["tcp.payload"].get<std::string>().compare(24, scan_head.size(), scan_head) == 0)
+      scan_segments.push_back(i);
+  }
+  ASSERT_EQ(scan_segments.size(), 174u);
+  // The tenth frame from the end: its length field (bytes 4..7, "02:02:02:02:LL:LL:LL:LL:") says 60000,
+  // more than the nine frames after it hold.
+  std::string& payload = doc[scan_segments[174 - 10]]["_source"]["layers"]["tcp"]["tcp.payload"].get_ref<std::string&>();
+  ASSERT_EQ(payload.substr(12, 11), "00:00:0d:d8");  // 3544 payload bytes, as every frame in the file
+  payload.replace(12, 11, "00:00:ea:60");
+  const fs::path garbled = dir_ / "garbled.pcapng.json";
+  std::ofstream(garbled) << doc.dump();
+
+  const fs::path out = dir_ / "frames.json";
+  const Outcome r = run("replay " + garbled.string() + " --quiet --json " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("173 LMDscandata frames (scan counter 54484..54657"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 bad length, 3553 garbage bytes"), std::string::npos) << r.out;
+  const std::string warning =
+      "warning: skipped 1 damaged frame (1 with a bad length field) and 3553 bytes in all, resuming at the next "
+      "frame start each time\n";
+  EXPECT_NE(r.err.find(warning), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;  // the warning and "wrote ..."
+  const nlohmann::json frames = nlohmann::json::parse(readText(out))["frames"];
+  ASSERT_EQ(frames.size(), 173u);
+  // Counters run 54484..54657 without the damaged frame's 54648.
+  for (size_t k = 0; k < frames.size(); ++k)
+    EXPECT_EQ(frames[k]["scan_counter"], 54484 + k + (k >= 164 ? 1 : 0)) << k;
+  // The frame after it is whole: DIST1 with its 1141 values.
+  EXPECT_EQ(frames[164]["channels16"][0]["values"].size(), 1141u);
+}
+
+// CoLa A has no length field: a frame whose ETX was lost ends at the next STX; it is dropped, counted, and
+// the frames around it are kept.
+TEST_F(ReplayCli, AsciiFrameWithoutItsEndIsSkippedToTheNextStart) {
+  const fs::path cap = dir_ / "session.sscap";
+  size_t damaged_size = 0;
+  {
+    sailshape::CaptureWriter w(cap.string(), sailshape::ColaDialect::kAscii);
+    for (uint16_t i = 1; i <= 5; ++i) {
+      sailshape::ScanData s;
+      s.scan_counter = i;
+      s.channels16 = {{"DIST1", 1.0f, 0.0f, -450000, 5000, {1000, 1001, 1002}}};
+      std::string frame = sailshape::frameCola(sailshape::ColaDialect::kAscii,
+                                               sailshape::encodeScanData(s, sailshape::ColaDialect::kAscii));
+      if (i == 3) {
+        frame.back() = ' ';  // the ETX lost
+        damaged_size = frame.size();
+      }
+      w.append({sailshape::CaptureDirection::kFromDevice, 100.0 + i, frame});
+    }
+  }
+  const fs::path out = dir_ / "frames.json";
+  const Outcome r = run("replay " + cap.string() + " --quiet --json " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: skipped 1 damaged frame (1 cut short) and " + std::to_string(damaged_size) +
+                       " bytes in all, resuming at the next frame start each time\n"),
+            std::string::npos)
+      << r.err;
+  const nlohmann::json frames = nlohmann::json::parse(readText(out))["frames"];
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_EQ(frames[1]["scan_counter"], 2);
+  EXPECT_EQ(frames[2]["scan_counter"], 4);
+  EXPECT_EQ(frames[3]["channels16"][0]["values"], nlohmann::json({1000, 1001, 1002}));
+}
+
 TEST_F(ReplayCli, OurCaptureCutShortIsReplayedUpToTheCut) {
   const fs::path cap = dir_ / "session.sscap";
   {
