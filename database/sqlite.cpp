@@ -66,7 +66,7 @@ Database::Database(const std::string& path, const OpenOptions& options)
   int flags = options.read_only ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE;
   if (options.create && !options.read_only) flags |= SQLITE_OPEN_CREATE;
   flags |= SQLITE_OPEN_NOMUTEX;
-  // A file nobody here may change is read as immutable: no locks and no -wal or
+  // A file this process may not change is read as immutable: no locks and no -wal or
   // -shm beside it; writes then fail as "attempt to write a readonly database".
   std::string name = path;
   if (unwritableWithoutPendingWal(path)) {

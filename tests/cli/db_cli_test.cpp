@@ -33,7 +33,11 @@ class DbCli : public ::testing::Test {
     fs::create_directories(dir_);
     db_ = (dir_ / "t.db").string();
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  void TearDown() override {
+    std::error_code ec;  // a folder a test made read-only must be writable again to be removed
+    fs::permissions(dir_ / "locked", fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(dir_);
+  }
 
   Outcome run(const std::string& args) { return sailshape::testing::runSailshape(dir_, args); }
 
@@ -296,7 +300,6 @@ TEST_F(DbCli, ReadingAReadOnlyDatabaseLeavesNothingBehind) {
   ASSERT_EQ(o.exit_code, 0) << o.err;
   EXPECT_EQ(countLines(o.out), 2);  // header + 1 scan
   EXPECT_EQ(sideFiles(locked), std::vector<std::string>{});
-  fs::permissions(locked, fs::perms::owner_all, fs::perm_options::add);
 }
 
 TEST_F(DbCli, ImportIntoAMissingFileSaysToInitItAndCreatesNothing) {
