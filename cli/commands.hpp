@@ -3,6 +3,8 @@
 // app and runs through a callback; errors propagate as exceptions to main().
 #include <CLI/CLI.hpp>
 
+#include <string>
+
 namespace sailshape::cli {
 
 void addAnalyzeCommand(CLI::App& app);
@@ -17,5 +19,12 @@ void addRegisterCommand(CLI::App& app);
 void addEmulateCommand(CLI::App& app);
 void addScanCommand(CLI::App& app);
 void addScannerCommand(CLI::App& app);
+
+// The global --verbose flag; add it before the subcommands, which inherit it.
+void addVerboseFlag(CLI::App& app);
+bool verbose();
+// An exception's message for the user: errors carry the function that raised
+// them ("[Statement::step] f.db: ..."), which only --verbose shows.
+std::string userMessage(const std::string& what);
 
 }  // namespace sailshape::cli

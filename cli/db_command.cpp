@@ -1,6 +1,7 @@
 // `sailshape db`: the design-flying database (database/).
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -51,6 +52,21 @@ OpenOptions openOptions(const DbOptions& o, bool create) {
   oo.create = create;
   oo.busy_timeout_ms = o.busy_timeout_ms;
   return oo;
+}
+
+// Every db command but init works on an existing file; SQLite's own message
+// ("unable to open database file") does not say what to do about a missing one.
+void requireExisting(const DbOptions& o, const char* command) {
+  std::error_code ec;
+  if (!std::filesystem::exists(o.db, ec))
+    throw InvalidInput(std::string("db ") + command + ": " + o.db + " does not exist; run `sailshape db init " + o.db +
+                       "` first");
+}
+
+// Opens an existing sailshape database (migrating it when older and writable).
+Database openExisting(const DbOptions& o, const char* command) {
+  requireExisting(o, command);
+  return openSailDatabase(o.db, openOptions(o, false));
 }
 
 std::map<std::string, double> parseAssignments(const std::vector<std::string>& items, const char* option) {
@@ -145,7 +161,7 @@ Table runQuery(Database& db, const DbOptions& o) {
 }
 
 void runImport(DbOptions o) {
-  Database db = openSailDatabase(o.db, openOptions(o, false));
+  Database db = openExisting(o, "import");
   ImportMetadata& m = o.meta;
   m.awa_deg = given(o.awa);
   m.aws_m_s = given(o.aws);
@@ -178,8 +194,11 @@ void runImport(DbOptions o) {
     cloud = std::move(r.cloud);
   }
   const ImportResult r = importScan(db, m, doc ? &*doc : nullptr, cloud ? &*cloud : nullptr);
-  std::printf("imported scan %lld (trim step %lld, %zu sections)\n", static_cast<long long>(r.scan_id),
-              static_cast<long long>(r.trim_step_id), r.sections);
+  // The step as the user numbered it within its test; the row id is what
+  // `db query --best` lists as trim_step_id.
+  const std::string test = m.test.empty() ? "" : " of test \"" + m.test + "\"";
+  std::printf("imported scan %lld (trim step %d%s, trim step id %lld, %zu sections)\n", static_cast<long long>(r.scan_id),
+              m.trim_step, test.c_str(), static_cast<long long>(r.trim_step_id), r.sections);
 }
 
 void addFilterOptions(CLI::App* cmd, DbOptions& o) {
@@ -241,7 +260,7 @@ void addImportOptions(CLI::App* imp, DbOptions& o) {
 
 // `db show`: one scan, its sections and the sections it could not measure; optionally its stored cloud.
 void runShow(const DbOptions& o) {
-  Database d = openSailDatabase(o.db, openOptions(o, false));
+  Database d = openExisting(o, "show");
   ScanFilter f;
   f.scan_id = o.scan_id;
   const Table scan = findScans(d, f);
@@ -281,24 +300,54 @@ void runExport(const DbOptions& o) {
     else if (endsWith(o.dest, ".json")) format = "json";
     else throw InvalidInput("db export: give --csv or --json (\"" + o.dest + "\" has neither extension)");
   }
-  Database d = openSailDatabase(o.db, openOptions(o, false));
+  Database d = openExisting(o, "export");
   const Table t = runQuery(d, o);
   writeTable(o.dest, t, format);
   std::printf("wrote %zu rows to %s\n", t.rows.size(), o.dest.c_str());
 }
 
-// `db check`: integrity and foreign keys of the file as it is; throws DatabaseError on any problem.
+// `db check`: whether the file is a sailshape database, and its integrity and
+// foreign keys as it is (no migration); throws on any problem, one line.
 void runCheck(const DbOptions& o) {
-  OpenOptions oo = openOptions(o, false);
-  Database d(o.db, oo);  // no migration: check the file as it is
+  requireExisting(o, "check");
+  const std::string not_ours = "db check: " + o.db + ": not a sailshape database";
+  std::error_code ec;
+  if (std::filesystem::file_size(o.db, ec) == 0 && !ec) throw DatabaseError(not_ours + " (empty file)");
+  Database d(o.db, openOptions(o, false));
   const int version = d.userVersion();
   if (version > kSchemaVersion)
     throw DatabaseError("db check: " + o.db + ": database schema version " + std::to_string(version) +
                         " is newer than this sailshape (" + std::to_string(kSchemaVersion) + ")");
-  const std::vector<std::string> problems = d.integrityCheck();
+  if (version == 0) {
+    Statement tables(d, "SELECT count(*) FROM sqlite_schema WHERE type = 'table'");
+    tables.step();
+    const int64_t n = tables.columnInt(0);
+    if (n > 0)
+      throw DatabaseError(not_ours + " (an SQLite database of another application: " + std::to_string(n) +
+                          (n == 1 ? " table" : " tables") + ", no sailshape schema)");
+    throw DatabaseError(not_ours + " (an SQLite database without tables; `sailshape db init " + o.db + "` makes it one)");
+  }
+  std::vector<std::string> problems;
+  try {
+    problems = d.integrityCheck();
+  } catch (const DatabaseError& e) {
+    // SQLite stops the check at pages it cannot read at all.
+    throw DatabaseError("db check: " + o.db + ": damaged: the integrity check stopped at an unreadable page (" +
+                        userMessage(e.what()) + ")");
+  }
+  // integrity_check heads its list with the database it checked; not a problem.
+  problems.erase(std::remove_if(problems.begin(), problems.end(),
+                                [](const std::string& p) { return p.rfind("*** in database", 0) == 0; }),
+                 problems.end());
   if (!problems.empty()) {
-    for (const auto& p : problems) std::fprintf(stderr, "  %s\n", p.c_str());
-    throw DatabaseError("db check: " + o.db + ": " + std::to_string(problems.size()) + " problem(s), first: " + problems[0]);
+    constexpr size_t kListed = 10;
+    if (verbose()) {
+      for (size_t i = 0; i < std::min(problems.size(), kListed); ++i) std::fprintf(stderr, "  %s\n", problems[i].c_str());
+      if (problems.size() > kListed) std::fprintf(stderr, "  ... and %zu more\n", problems.size() - kListed);
+    }
+    throw DatabaseError("db check: " + o.db + ": damaged: " + std::to_string(problems.size()) + " integrity problem" +
+                        (problems.size() == 1 ? "" : "s") + ", first: " + problems[0] +
+                        (verbose() ? "" : " (--verbose lists them)"));
   }
   std::printf("%s: ok (schema version %d)\n", o.db.c_str(), version);
 }
@@ -337,7 +386,7 @@ void addDbCommand(CLI::App& app) {
   list->add_flag("--csv", o->csv, "Print CSV");
   list->add_flag("--json", o->json, "Print JSON")->excludes("--csv");
   list->callback([o] {
-    Database d = openSailDatabase(o->db, openOptions(*o, false));
+    Database d = openExisting(*o, "list");
     emit(findScans(d, filterOf(*o)), *o);
   });
 
@@ -357,7 +406,7 @@ void addDbCommand(CLI::App& app) {
   query->add_flag("--csv", o->csv, "Print CSV");
   query->add_flag("--json", o->json, "Print JSON")->excludes("--csv");
   query->callback([o] {
-    Database d = openSailDatabase(o->db, openOptions(*o, false));
+    Database d = openExisting(*o, "query");
     emit(runQuery(d, *o), *o);
   });
 
@@ -378,7 +427,7 @@ void addDbCommand(CLI::App& app) {
   add_db(backup);
   backup->add_option("DEST", o->dest, "Destination file (replaced)")->required();
   backup->callback([o] {
-    Database d = openSailDatabase(o->db, openOptions(*o, false));
+    Database d = openExisting(*o, "backup");
     d.backupTo(o->dest);
     std::printf("backed up %s to %s\n", o->db.c_str(), o->dest.c_str());
   });

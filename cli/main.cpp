@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
       "Units are SI (metres); angles in degrees on the command line. Boat frame: +X forward, +Y port, +Z up."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "sailshape 0.1.0");
+  sailshape::cli::addVerboseFlag(app);
   sailshape::cli::addAnalyzeCommand(app);
   sailshape::cli::addSimulateCommand(app);
   sailshape::cli::addDesignCommand(app);
@@ -37,7 +38,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sailshape: %s (see --help)\n", e.what());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "sailshape: error: %s\n", e.what());
+    std::fprintf(stderr, "sailshape: error: %s\n", sailshape::cli::userMessage(e.what()).c_str());
     return 1;
   }
   return 0;

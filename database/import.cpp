@@ -28,6 +28,18 @@ std::optional<double> number(const nlohmann::json& j, const char* key) {
   return it->get<double>();
 }
 
+// A section's value: missing or null is "not measured" (NULL); anything but a
+// number refuses the whole import rather than storing NULL for a typo.
+std::optional<double> measured(const nlohmann::json& object, const char* key, const std::string& where,
+                               const char* function) {
+  auto it = object.find(key);
+  if (it == object.end() || it->is_null()) return std::nullopt;
+  if (!it->is_number())
+    throw InvalidInput(std::string("[") + function + "] " + where + ": " + key + " must be a number or null (got " +
+                       it->dump() + ")");
+  return it->get<double>();
+}
+
 void requireFinite(const std::optional<double>& v, const char* name) {
   if (v && !std::isfinite(*v))
     throw InvalidInput(std::string("[importScan] ") + name + " must be finite (got " + std::to_string(*v) + ")");
@@ -84,13 +96,24 @@ int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, 
       throw InvalidInput(std::string("[") + function + "] section fraction must be in (0, 1) (got " +
                          j.value("fraction", nlohmann::json()).dump() + ")");
     sec.bind(1, analysis_id).bind(2, *fraction);
-    const nlohmann::json u = j.value("uncertainty", nlohmann::json::object());
-    for (int k = 0; k < 7; ++k) {
-      sec.bind(3 + k, number(j, kParameters[k]));
-      sec.bind(10 + k, number(u, kParameters[k]));
+    const std::string where = "section " + formatFixed(*fraction);
+    nlohmann::json u = nlohmann::json::object();
+    if (j.contains("uncertainty") && !j["uncertainty"].is_null()) {
+      u = j["uncertainty"];
+      if (!u.is_object())
+        throw InvalidInput(std::string("[") + function + "] " + where + ": uncertainty must be an object (got " + u.dump() + ")");
     }
-    sec.bind(17, number(j, "plane_tilt_deg"));
-    sec.bind(18, j.value("converged", true) ? 1 : 0);
+    for (int k = 0; k < 7; ++k) {
+      sec.bind(3 + k, measured(j, kParameters[k], where, function));
+      sec.bind(10 + k, measured(u, kParameters[k], where + " uncertainty", function));
+    }
+    sec.bind(17, measured(j, "plane_tilt_deg", where, function));
+    nlohmann::json converged = j.value("converged", nlohmann::json(true));
+    if (converged.is_null()) converged = true;
+    if (!converged.is_boolean())
+      throw InvalidInput(std::string("[") + function + "] " + where + ": converged must be true or false (got " +
+                         converged.dump() + ")");
+    sec.bind(18, converged.get<bool>() ? 1 : 0);
     std::vector<Vec3> curve;
     if (j.contains("curve"))
       for (const auto& p : j["curve"]) curve.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());

@@ -155,11 +155,11 @@ Database openSailDatabase(const std::string& path, const OpenOptions& options) {
                           ": an SQLite database of another application (tables but no sailshape schema); left untouched");
   }
   // WAL: readers (the viewer) keep reading while a scan is written.
-  if (!options.read_only) db.exec("PRAGMA journal_mode=WAL");
+  if (!db.readOnly()) db.exec("PRAGMA journal_mode=WAL");
   if (version < kSchemaVersion) {
-    if (options.read_only)
+    if (db.readOnly())
       throw DatabaseError("[openSailDatabase] " + path + ": schema version " + std::to_string(version) +
-                          " needs a migration; open it writable");
+                          " needs a migration; open it writable (the file or its folder is read-only here)");
     migrateSchema(db);
   }
   return db;

@@ -1,7 +1,9 @@
 #include "database/sqlite.hpp"
 
 #include <sqlite3.h>
+#include <unistd.h>
 
+#include <filesystem>
 #include <utility>
 
 namespace sailshape {
@@ -10,6 +12,36 @@ namespace {
 std::string describe(sqlite3* db, int rc) {
   std::string msg = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
   return msg + " (" + sqlite3_errstr(rc) + ", code " + std::to_string(rc) + ")";
+}
+
+// True when this process cannot write the file or its folder, and no -wal with
+// content lies beside it. SQLite would open such a WAL database read-only and
+// leave read-only -wal and -shm files behind (or, in a read-only folder, fail
+// to create them). A -wal with content holds commits the file lacks; reading
+// the file as immutable would miss them.
+bool unwritableWithoutPendingWal(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (path.empty() || path == ":memory:" || !fs::is_regular_file(path, ec)) return false;
+  fs::path folder = fs::path(path).parent_path();
+  if (folder.empty()) folder = ".";
+  const bool writable = ::access(path.c_str(), W_OK) == 0 && ::access(folder.c_str(), W_OK) == 0;
+  if (writable) return false;
+  const auto wal_size = fs::file_size(path + "-wal", ec);
+  return ec || wal_size == 0;
+}
+
+// `path` as an SQLite URI ("file:...?immutable=1"): '%', '?' and '#' escaped.
+std::string immutableUri(const std::string& path) {
+  std::string uri = "file:";
+  if (path.rfind("//", 0) == 0) uri += "//localhost";  // keep "//x" from reading as an authority
+  for (char c : path) {
+    if (c == '%') uri += "%25";
+    else if (c == '?') uri += "%3f";
+    else if (c == '#') uri += "%23";
+    else uri += c;
+  }
+  return uri + "?immutable=1";
 }
 
 }  // namespace
@@ -34,7 +66,14 @@ Database::Database(const std::string& path, const OpenOptions& options)
   int flags = options.read_only ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE;
   if (options.create && !options.read_only) flags |= SQLITE_OPEN_CREATE;
   flags |= SQLITE_OPEN_NOMUTEX;
-  const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr);
+  // A file this process may not change is read as immutable: no locks and no -wal or
+  // -shm beside it; writes then fail as "attempt to write a readonly database".
+  std::string name = path;
+  if (unwritableWithoutPendingWal(path)) {
+    name = immutableUri(path);
+    flags = SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_NOMUTEX;
+  }
+  const int rc = sqlite3_open_v2(name.c_str(), &db_, flags, nullptr);
   if (rc != SQLITE_OK) {
     const std::string msg = describe(db_, rc);
     sqlite3_close(db_);
@@ -81,6 +120,8 @@ void Database::exec(const std::string& sql) {
 }
 
 Statement Database::prepare(const std::string& sql) { return Statement(*this, sql); }
+
+bool Database::readOnly() const { return sqlite3_db_readonly(db_, "main") == 1; }
 
 int64_t Database::lastInsertId() const { return sqlite3_last_insert_rowid(db_); }
 

@@ -36,7 +36,9 @@ class Database {
   // Opens (or creates) `path`, checks that it is an SQLite database before
   // anything is written, then sets foreign_keys=ON and the busy timeout.
   // Writes nothing: WAL mode and the schema are openSailDatabase()'s
-  // (database/schema.hpp), once the file is known to be ours.
+  // (database/schema.hpp), once the file is known to be ours. A file this
+  // process may not write (mode 0444, or in a read-only folder) is opened
+  // read-only and immutable, so reading it leaves no -wal or -shm behind.
   explicit Database(const std::string& path, const OpenOptions& options = {});
   ~Database();
   Database(Database&& other) noexcept;
@@ -47,6 +49,8 @@ class Database {
   void exec(const std::string& sql);
   Statement prepare(const std::string& sql);
   int64_t lastInsertId() const;
+  // True when SQLite opened the file read-only (asked for, or not writable here).
+  bool readOnly() const;
   int userVersion();
   void setUserVersion(int version);
   int busyTimeoutMs() const { return busy_timeout_ms_; }

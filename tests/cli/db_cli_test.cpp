@@ -5,13 +5,16 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "database/sqlite.hpp"
 #include "tests/cli/run_sailshape.hpp"
 
 namespace {
@@ -30,9 +33,36 @@ class DbCli : public ::testing::Test {
     fs::create_directories(dir_);
     db_ = (dir_ / "t.db").string();
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  void TearDown() override {
+    std::error_code ec;  // a folder a test made read-only must be writable again to be removed
+    fs::permissions(dir_ / "locked", fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(dir_);
+  }
 
   Outcome run(const std::string& args) { return sailshape::testing::runSailshape(dir_, args); }
+
+  // As run(), but as user nobody when the tests run as root: file modes do not
+  // stop root, and the read-only cases are about users they do stop.
+  Outcome runUnprivileged(const std::string& args) {
+    if (::geteuid() != 0) return run(args);
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string("setpriv --reuid=65534 --regid=65534 --clear-groups '") + SAILSHAPE_BIN + "' " +
+                            args + " >'" + out.string() + "' 2>'" + err.string() + "' </dev/null";
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readText(out), readText(err)};
+  }
+
+  // Files SQLite keeps beside a database while it is open (-wal, -shm, -journal).
+  std::vector<std::string> sideFiles(const fs::path& folder) {
+    std::vector<std::string> found;
+    for (const auto& e : fs::directory_iterator(folder)) {
+      const std::string name = e.path().filename().string();
+      for (const char* tail : {"-wal", "-shm", "-journal"})
+        if (name.size() > std::strlen(tail) && name.compare(name.size() - std::strlen(tail), std::string::npos, tail) == 0)
+          found.push_back(name);
+    }
+    return found;
+  }
 
   std::string analysisJson(double camber) {
     nlohmann::json doc;
@@ -179,6 +209,166 @@ TEST_F(DbCli, ErrorsAreOneLineAndNonZero) {
   EXPECT_NE(no_format.exit_code, 0);
   EXPECT_NE(no_format.err.find("--csv or --json"), std::string::npos) << no_format.err;
   EXPECT_NE(run("db query " + db_ + " --evolution camber_pct").exit_code, 0);  // needs --test
+}
+
+TEST_F(DbCli, CheckSaysInOneLineWhenTheFileIsNotOurs) {
+  const std::string empty = (dir_ / "empty.db").string();
+  std::ofstream{empty};
+  Outcome o = run("db check " + empty);
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err, "sailshape: error: db check: " + empty + ": not a sailshape database (empty file)\n");
+  EXPECT_EQ(fs::file_size(empty), 0u);
+
+  const std::string foreign = (dir_ / "foreign.db").string();
+  {
+    sailshape::Database other(foreign);
+    other.exec("CREATE TABLE notes(id INTEGER PRIMARY KEY, body TEXT); CREATE TABLE tags(name TEXT)");
+  }
+  o = run("db check " + foreign);
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err, "sailshape: error: db check: " + foreign +
+                       ": not a sailshape database (an SQLite database of another application: 2 tables, no sailshape "
+                       "schema)\n");
+}
+
+TEST_F(DbCli, CheckOfADamagedFileIsOneLineAndListsOnlyWithVerbose) {
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  for (int step = 0; step < 3; ++step)
+    ASSERT_EQ(run("db import " + db_ + " " + analysisJson(8 + step) + " --trim-step " + std::to_string(step)).exit_code, 0);
+  int64_t root_page = 0, page_size = 0;
+  {
+    sailshape::Database d(db_);
+    sailshape::Statement s = d.prepare("SELECT rootpage FROM sqlite_schema WHERE name = 'sections_analysis'");
+    ASSERT_TRUE(s.step());
+    root_page = s.columnInt(0);
+    sailshape::Statement p = d.prepare("PRAGMA page_size");
+    p.step();
+    page_size = p.columnInt(0);
+  }
+  // Bytes overwritten in the middle of the file: the index of the 9 section rows
+  // becomes an empty leaf page (type 0x0a, no cells), so every row misses from it.
+  {
+    std::fstream f(db_, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp((root_page - 1) * page_size);
+    std::string page(static_cast<size_t>(page_size), '\0');
+    page[0] = 0x0a;
+    page[5] = static_cast<char>(page_size >> 8);
+    page[6] = static_cast<char>(page_size & 0xff);
+    f.write(page.data(), static_cast<std::streamsize>(page.size()));
+  }
+  Outcome o = run("db check " + db_);
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err, "sailshape: error: db check: " + db_ +
+                       ": damaged: 10 integrity problems, first: row 1 missing from index sections_analysis (--verbose "
+                       "lists them)\n");
+  o = run("db check " + db_ + " --verbose");
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(countLines(o.err), 11) << o.err;  // ten problems listed, then the one line
+  EXPECT_EQ(o.err.rfind("  row 1 missing from index sections_analysis\n", 0), 0u) << o.err;
+  EXPECT_NE(o.err.find("wrong # of entries in index sections_analysis"), std::string::npos) << o.err;
+}
+
+TEST_F(DbCli, ReadingAReadOnlyDatabaseLeavesNothingBehind) {
+  if (::geteuid() == 0 && std::system("command -v setpriv >/dev/null") != 0) GTEST_SKIP() << "root without setpriv";
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  ASSERT_EQ(run("db import " + db_ + " " + analysisJson(8) + " --sail G1").exit_code, 0);
+  ASSERT_TRUE(sideFiles(dir_).empty());
+  const std::string before = readText(db_);
+
+  // Mode 0444 in a folder the reader may write.
+  fs::permissions(db_, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  fs::permissions(dir_, fs::perms::all);
+  Outcome o = runUnprivileged("db query " + db_ + " --sections --csv");
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_EQ(countLines(o.out), 4);  // header + 3 sections
+  o = runUnprivileged("db show " + db_ + " 1");
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_NE(o.out.find("G1"), std::string::npos) << o.out;
+  EXPECT_EQ(sideFiles(dir_), std::vector<std::string>{});
+  EXPECT_EQ(readText(db_), before);
+
+  // A writable file in a folder the reader may not write.
+  const fs::path locked = dir_ / "locked";
+  fs::create_directories(locked);
+  const std::string inside = (locked / "t.db").string();
+  fs::copy_file(db_, inside);
+  fs::permissions(inside, fs::perms::all);
+  fs::permissions(locked, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                              fs::perms::others_exec);
+  if (::geteuid() != 0) fs::permissions(locked, fs::perms::owner_write, fs::perm_options::remove);
+  o = runUnprivileged("db list " + inside + " --csv");
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_EQ(countLines(o.out), 2);  // header + 1 scan
+  EXPECT_EQ(sideFiles(locked), std::vector<std::string>{});
+}
+
+TEST_F(DbCli, ImportIntoAMissingFileSaysToInitItAndCreatesNothing) {
+  const std::string missing = (dir_ / "missing.db").string();
+  const Outcome o = run("db import " + missing + " " + analysisJson(8));
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err, "sailshape: error: db import: " + missing + " does not exist; run `sailshape db init " + missing +
+                       "` first\n");
+  EXPECT_FALSE(fs::exists(missing));
+}
+
+TEST_F(DbCli, ImportNamesTheTrimStepAsGivenAndItsIdAsAnId) {
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  ASSERT_EQ(run("db import " + db_ + " " + analysisJson(8) + " --test sweep --trim-step 0").exit_code, 0);
+  ASSERT_EQ(run("db import " + db_ + " " + analysisJson(8) + " --test reach --trim-step 0").exit_code, 0);
+  Outcome o = run("db import " + db_ + " " + analysisJson(9) + " --test sweep --trim-step 1");
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_EQ(o.out, "imported scan 3 (trim step 1 of test \"sweep\", trim step id 3, 3 sections)\n");
+  o = run("db import " + db_ + " " + analysisJson(10) + " --trim-step 1");
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_EQ(o.out, "imported scan 4 (trim step 1, trim step id 4, 3 sections)\n");
+}
+
+TEST_F(DbCli, WrongTypedValueRefusesTheImportNamingFieldAndSection) {
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  nlohmann::json doc = nlohmann::json::parse(readText(analysisJson(8)));
+  doc["sections"][1]["camber_pct"] = "lots";
+  const fs::path file = dir_ / "typo.json";
+  std::ofstream(file) << doc.dump();
+  Outcome o = run("db import " + db_ + " " + file.string());
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err, "sailshape: error: section 0.500: camber_pct must be a number or null (got \"lots\")\n");
+  o = run("db list " + db_ + " --csv");
+  EXPECT_EQ(countLines(o.out), 1) << o.out;  // the header only: nothing stored
+
+  doc["sections"][1]["camber_pct"] = 9.0;
+  doc["sections"][2]["uncertainty"]["draft_pct"] = {1.0};
+  std::ofstream(file, std::ios::trunc) << doc.dump();
+  o = run("db import " + db_ + " " + file.string());
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err, "sailshape: error: section 0.750 uncertainty: draft_pct must be a number or null (got [1.0])\n");
+
+  // null means "not measured" and stays allowed.
+  doc["sections"][2]["uncertainty"]["draft_pct"] = nullptr;
+  doc["sections"][2]["camber_pct"] = nullptr;
+  std::ofstream(file, std::ios::trunc) << doc.dump();
+  o = run("db import " + db_ + " " + file.string());
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  o = run("db query " + db_ + " --sections --json");
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  const auto rows = nlohmann::json::parse(o.out);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_DOUBLE_EQ(rows[1]["camber_pct"].get<double>(), 9.0);
+  EXPECT_TRUE(rows[2]["camber_pct"].is_null()) << rows[2].dump();
+}
+
+TEST_F(DbCli, ErrorsNameTheInternalFunctionOnlyWithVerbose) {
+  const std::string notes = (dir_ / "notes.db").string();
+  std::ofstream(notes) << "not a database, just a long enough line of text to fill a header\n";
+  Outcome o = run("db list " + notes);
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err, "sailshape: error: " + notes + ": not an SQLite database (or encrypted); left untouched\n");
+  for (const std::string& args : {"--verbose db list " + notes, "db list " + notes + " --verbose"}) {
+    o = run(args);
+    EXPECT_NE(o.exit_code, 0) << args;
+    EXPECT_EQ(o.err, "sailshape: error: [Database::exec] " + notes +
+                         ": not an SQLite database (or encrypted); left untouched\n")
+        << args;
+  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <zlib.h>
 
 #include <cstring>
+#include <functional>
 #include <random>
 
 #include "analysis/core/errors.hpp"
@@ -269,6 +270,45 @@ TEST(Import, BadInputThrowsAndStoresNothing) {
   EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 0);
   EXPECT_EQ(count(db, "SELECT count(*) FROM trim_steps"), 0);
   EXPECT_EQ(count(db, "SELECT count(*) FROM campaigns"), 0);
+}
+
+TEST(Import, WrongTypedValuesAreRefusedNamingFieldAndSectionWhileNullIsNotMeasured) {
+  TempDir dir;
+  Database db = openSailDatabase(dir.file("a.db"));
+  struct Case {
+    std::function<void(nlohmann::json&)> spoil;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {[](nlohmann::json& d) { d["sections"][1]["camber_pct"] = "lots"; },
+       "[importScan] section 0.500: camber_pct must be a number or null (got \"lots\")"},
+      {[](nlohmann::json& d) { d["sections"][0]["plane_tilt_deg"] = true; },
+       "[importScan] section 0.250: plane_tilt_deg must be a number or null (got true)"},
+      {[](nlohmann::json& d) { d["sections"][2]["uncertainty"]["twist_deg"] = "0.5"; },
+       "[importScan] section 0.750 uncertainty: twist_deg must be a number or null (got \"0.5\")"},
+      {[](nlohmann::json& d) { d["sections"][2]["uncertainty"] = 0.5; },
+       "[importScan] section 0.750: uncertainty must be an object (got 0.5)"},
+      {[](nlohmann::json& d) { d["sections"][1]["converged"] = "yes"; },
+       "[importScan] section 0.500: converged must be true or false (got \"yes\")"},
+  };
+  for (const Case& c : cases) {
+    nlohmann::json doc = analysisDoc(8.0);
+    c.spoil(doc);
+    try {
+      importScan(db, meta(0, 90), &doc);
+      ADD_FAILURE() << c.message;
+    } catch (const InvalidInput& e) {
+      EXPECT_EQ(std::string(e.what()), c.message);
+    }
+  }
+  EXPECT_EQ(count(db, "SELECT count(*) FROM scans"), 0);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM sections"), 0);
+
+  nlohmann::json doc = analysisDoc(8.0);
+  doc["sections"][1]["camber_pct"] = nullptr;
+  doc["sections"][1].erase("draft_pct");
+  EXPECT_EQ(importScan(db, meta(0, 90), &doc).sections, 3u);
+  EXPECT_EQ(count(db, "SELECT count(*) FROM sections WHERE camber_pct IS NULL AND draft_pct IS NULL AND fraction = 0.5"), 1);
 }
 
 TEST(Import, WriterKilledMidImportLeavesFileConsistentAndScanAbsent) {
