@@ -308,7 +308,8 @@ void runCheck(const DbOptions& o) {
 void addDbCommand(CLI::App& app) {
   auto o = std::make_shared<DbOptions>();
   CLI::App* db = app.add_subcommand(
-      "db", "The design-flying database (one SQLite file): store scans with their trim steps and analyses, query them, "
+      "db", "The design-flying database: store scans with their trim steps, query, export, check\n\n"
+            "The design-flying database (one SQLite file): store scans with their trim steps and analyses, query them, "
             "export, check and back up.");
   db->require_subcommand(1);
   auto add_db = [&](CLI::App* cmd) {

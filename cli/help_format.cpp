@@ -1,0 +1,62 @@
+#include "cli/help_format.hpp"
+
+#include <memory>
+#include <sstream>
+
+namespace sailshape::cli {
+namespace {
+
+constexpr size_t kOptionColumn = 30;  // where option descriptions start (CLI11's default column)
+
+}  // namespace
+
+std::string wrapText(const std::string& text, size_t width) {
+  std::string out;
+  std::istringstream lines(text);
+  bool first_line = true;
+  for (std::string line; std::getline(lines, line); first_line = false) {
+    if (!first_line) out += '\n';
+    // An indented line (an example, a list item) continues at its own indent.
+    const std::string indent = line.substr(0, line.find_first_not_of(' ') == std::string::npos
+                                                  ? 0
+                                                  : line.find_first_not_of(' '));
+    out += indent;
+    size_t column = indent.size();
+    bool line_empty = true;
+    std::istringstream words(line);
+    for (std::string word; words >> word; line_empty = false) {
+      if (!line_empty && column + 1 + word.size() > width) {
+        out += '\n' + indent;
+        column = indent.size();
+      } else if (!line_empty) {
+        out += ' ';
+        ++column;
+      }
+      out += word;
+      column += word.size();
+    }
+  }
+  return out;
+}
+
+HelpFormatter::HelpFormatter() { column_width(kOptionColumn); }
+
+std::string HelpFormatter::make_subcommand(const CLI::App* sub) const {
+  const std::string& desc = sub->get_description();
+  std::stringstream out;
+  CLI::detail::format_help(out, sub->get_display_name(true), desc.substr(0, desc.find('\n')), column_width_);
+  return out.str();
+}
+
+std::string HelpFormatter::make_description(const CLI::App* app) const {
+  const std::string desc = CLI::Formatter::make_description(app);
+  return desc.empty() ? desc : wrapText(desc, kHelpWidth) + "\n\n";
+}
+
+std::string HelpFormatter::make_option_desc(const CLI::Option* opt) const {
+  return wrapText(CLI::Formatter::make_option_desc(opt), kHelpWidth - kOptionColumn);
+}
+
+void useHelpFormatter(CLI::App& app) { app.formatter(std::make_shared<HelpFormatter>()); }
+
+}  // namespace sailshape::cli
