@@ -123,7 +123,7 @@ void addAnalyzeCommand(CLI::App& app) {
   auto opt = std::make_shared<AnalyzeOptions>();
   CLI::App* cmd = app.add_subcommand(
       "analyze",
-      "Measure a flying sail from a cloud: corners, edges, sections with camber, draft, twist\n\n"
+      "Measure a flying sail from a cloud: its outline and sections (camber, draft, twist)\n\n"
       "Analyse a cloud of a flying sail (alone or in a scene with mast, boom and deck, in the boat frame): "
       "segment it, clean and smooth it, build its surface, find corners and edges, and cut sections with "
       "camber, draft, twist, entry and exit angles, each with its uncertainty. A scan that carries its samples' "

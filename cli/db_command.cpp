@@ -327,7 +327,7 @@ void addDbCommand(CLI::App& app) {
   });
 
   CLI::App* imp = db->add_subcommand(
-      "import", "Store one scan in one transaction: FILE is the JSON of `sailshape analyze --json` or a cloud file");
+      "import", "Store one scan (the JSON of `sailshape analyze --json`, or a cloud) in one transaction");
   add_db(imp);
   addImportOptions(imp, *o);
   imp->callback([o] { runImport(*o); });

@@ -83,13 +83,15 @@ const std::vector<CommandExamples>& examples() {
         "sailshape scan --unit assets/unit-tunnel-leeward.json --unit assets/unit-tunnel-windward.json --trigger "
         "--out scan2"}},
       {"scanner",
-       {"sailshape scanner calibrate --plane scan1/tunnel-leeward.samples.csv --unit assets/unit-tunnel-leeward.json "
-        "--write-unit leeward-calibrated.json"}},
+       {"sailshape scanner calibrate --plane scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,-2.1,-1.7 --plane "
+        "scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,1.7,2.1 --unit assets/unit-tunnel-leeward.json --write-unit "
+        "leeward-calibrated.json"}},
       {"scanner calibrate",
-       {"sailshape scanner calibrate --plane scan1/tunnel-leeward.samples.csv --unit assets/unit-tunnel-leeward.json "
-        "--write-unit leeward-calibrated.json",
-        "sailshape scanner calibrate --plane scan1/tunnel-leeward.samples.csv@-3,3,-3,3,-1,0 --plane "
-        "scan1/tunnel-leeward.samples.csv@-3,3,2,3,-1,3 --json calibration.json"}},
+       {"sailshape scanner calibrate --plane scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,-2.1,-1.7 --plane "
+        "scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,1.7,2.1 --unit assets/unit-tunnel-leeward.json --write-unit "
+        "leeward-calibrated.json",
+        "sailshape scanner calibrate --plane scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,-2.1,-1.7 --plane "
+        "scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,1.7,2.1 --p0 0.1 --theta0 10 --json calibration.json"}},
   };
   return table;
 }

@@ -57,6 +57,34 @@ std::string HelpFormatter::make_option_desc(const CLI::Option* opt) const {
   return wrapText(CLI::Formatter::make_option_desc(opt), kHelpWidth - kOptionColumn);
 }
 
+std::string HelpFormatter::make_footer(const CLI::App* app) const {
+  // An example command line breaks before an option, with a shell continuation, so
+  // it pastes as it is; other footer lines wrap as text.
+  std::string out;
+  std::istringstream lines(app->get_footer());
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("  sailshape", 0) != 0) {
+      out += wrapText(line, kHelpWidth) + "\n";
+      continue;
+    }
+    size_t column = 0;
+    for (size_t start = 0; start < line.size();) {
+      size_t end = line.find(" --", start + 1);
+      if (end == std::string::npos) end = line.size();
+      const std::string chunk = line.substr(start, end - start);  // " --option value", or the command itself
+      if (column > 0 && column + chunk.size() + 2 > kHelpWidth) {
+        out += " \\\n   ";
+        column = 3;
+      }
+      out += chunk;
+      column += chunk.size();
+      start = end;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
 void useHelpFormatter(CLI::App& app) { app.formatter(std::make_shared<HelpFormatter>()); }
 
 }  // namespace sailshape::cli

@@ -20,6 +20,7 @@ class HelpFormatter : public CLI::Formatter {
   std::string make_subcommand(const CLI::App* sub) const override;
   std::string make_description(const CLI::App* app) const override;
   std::string make_option_desc(const CLI::Option* opt) const override;
+  std::string make_footer(const CLI::App* app) const override;
 };
 
 // Gives `app` (and every subcommand added to it afterwards) the HelpFormatter.
