@@ -168,7 +168,7 @@ void addDesignCommand(CLI::App& app) {
       "design",
       "Generate a parametric design sail (new) or report on a design file (show)\n\n"
       "Design sails: generate a parametric design mesh (new), or read any design file and report its "
-                "dimensions and section parameters (show).");
+      "dimensions and section parameters (show).");
   design->require_subcommand(1);
 
   auto n = std::make_shared<NewOptions>();

@@ -82,6 +82,7 @@ const std::vector<CommandExamples>& examples() {
        {"sailshape scan --unit assets/unit-tunnel-leeward.json --out scan1",
         "sailshape scan --unit assets/unit-tunnel-leeward.json --unit assets/unit-tunnel-windward.json --trigger "
         "--out scan2"}},
+      // The boxes (unit frame, metres) keep the tunnel's floor and ceiling as the leeward unit sees them.
       {"scanner",
        {"sailshape scanner calibrate --plane scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,-2.1,-1.7 --plane "
         "scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,1.7,2.1 --unit assets/unit-tunnel-leeward.json --write-unit "

@@ -17,9 +17,8 @@ std::string wrapText(const std::string& text, size_t width) {
   for (std::string line; std::getline(lines, line); first_line = false) {
     if (!first_line) out += '\n';
     // An indented line (an example, a list item) continues at its own indent.
-    const std::string indent = line.substr(0, line.find_first_not_of(' ') == std::string::npos
-                                                  ? 0
-                                                  : line.find_first_not_of(' '));
+    const size_t text_start = line.find_first_not_of(' ');
+    const std::string indent = text_start == std::string::npos ? "" : line.substr(0, text_start);
     out += indent;
     size_t column = indent.size();
     bool line_empty = true;

@@ -123,7 +123,8 @@ void run(const CalibrateOptions& o) {
 void addScannerCommand(CLI::App& app) {
   CLI::App* scanner = app.add_subcommand(
       "scanner", "Scanner unit maintenance: calibrate a unit's p and θ from sweeps of known shapes\n\n"
-                 "calibrate: least squares from sweeps of planes (and cylinders of known radius).");
+                 "Its command calibrate fits p and θ (SPEC §2) by least squares to sweeps of planes, and of "
+                 "cylinders of known radius.");
   scanner->require_subcommand(1);
   auto o = std::make_shared<CalibrateOptions>();
   CLI::App* cmd = scanner->add_subcommand(
