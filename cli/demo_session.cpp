@@ -1,5 +1,6 @@
 #include "cli/demo_session.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -424,18 +425,27 @@ void registerOnWalls(DemoRun& run, size_t i, const Sweep& sweep, const std::stri
 }
 
 // The spars where this cloud has them: the registration is good to a couple of
-// centimetres, as much as the gap between the mast and the luff.
-std::vector<Spar> findSpars(const DemoRun& run, const Cloud& boat_cloud, double sensor_sigma_m, const std::string& who) {
+// centimetres, as much as the gap between the mast and the luff. A spar this unit
+// cannot see is a warning of the step; the log says it the first time only, as
+// the unit stands still and misses it at every step.
+std::vector<Spar> findSpars(DemoRun& run, const Cloud& boat_cloud, double sensor_sigma_m, int step,
+                            const std::string& tag, const std::string& unit) {
   std::vector<Spar> spars;
   for (const Spar& nominal : run.spars) {
     SparFitParams fp;
     fp.sensor_sigma_m = sensor_sigma_m;
     const SparFit f = fitSpar(boat_cloud, nominal, fp);
-    if (f.found)
-      run.log(who + ": " + nominal.name + " found " +
+    if (f.found) {
+      run.log(tag + ": " + unit + ": " + nominal.name + " found " +
               std::to_string(static_cast<int>(std::lround(1000 * f.offset.norm()))) + " mm from its measured place");
-    else
-      run.log(who + ": " + f.message + "; its measured place is used");
+    } else {
+      const std::string text = unit + ": " + f.message + "; its measured place is used";
+      std::vector<StepWarning>& warnings = run.result.warnings;
+      const bool said =
+          std::any_of(warnings.begin(), warnings.end(), [&](const StepWarning& w) { return sameWarning(w.text, text); });
+      if (!said) run.log(tag + ": " + text);
+      warnings.push_back({step + 1, text});
+    }
     spars.push_back(f.spar);
   }
   return spars;
@@ -453,7 +463,7 @@ void analyseUnit(DemoRun& run, size_t i, int step, const Sweep& sweep, const std
   useScannerBeam(ap.outline, u.config.model);
   ap.outline.design_lengths_m = {u.design_sections.outline.luff_length_m, u.design_sections.outline.leech_length_m,
                                  u.design_sections.outline.foot_length_m};
-  const std::vector<Spar> spars = findSpars(run, out.boat_cloud, ap.sensor_sigma_m, tag + ": " + u.config.name);
+  const std::vector<Spar> spars = findSpars(run, out.boat_cloud, ap.sensor_sigma_m, step, tag, u.config.name);
   const double max_x = u.roi_ends_at_mast ? spars.front().base.x() : 1e9;
   // The whole scan loses its mixed pixels before the crop cuts off the surfaces behind
   // them that tell them apart (a sail's head seen against the other sail would keep a fringe).

@@ -69,6 +69,8 @@ std::string stepsText(const std::set<int>& steps) {
 
 }  // namespace
 
+bool sameWarning(const std::string& a, const std::string& b) { return cut(a).literals == cut(b).literals; }
+
 std::vector<std::string> summariseWarnings(const std::vector<StepWarning>& warnings) {
   std::vector<Group> groups;
   for (const StepWarning& w : warnings) {

@@ -17,4 +17,7 @@ struct StepWarning {
 // a warning raised once keeps its text and its step: "... (step 2)".
 std::vector<std::string> summariseWarnings(const std::vector<StepWarning>& warnings);
 
+// Whether two warnings say the same but for their numbers (summariseWarnings makes them one line).
+bool sameWarning(const std::string& a, const std::string& b);
+
 }  // namespace sailshape::cli

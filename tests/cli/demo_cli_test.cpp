@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -46,7 +47,8 @@ class DemoRun : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("sailshape-demo-test-" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    outcome_ = runSailshape(dir_, "demo --dir '" + (dir_ / "out").string() + "' --steps 2 --scan-lines 300 --quiet");
+    // Not --quiet: its stage log on stderr is checked too.
+    outcome_ = runSailshape(dir_, "demo --dir '" + (dir_ / "out").string() + "' --steps 2 --scan-lines 300");
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
@@ -106,6 +108,17 @@ TEST_F(DemoRun, SaysEachWarningOnce) {
   }
   // The end-angle warning comes per section, end and step; said once per sail and end.
   EXPECT_LE(too_few, 4) << outcome_.out;
+
+  // A spar a unit cannot see, it misses at every step: the stage log says so once.
+  std::string log = outcome_.err;
+  std::replace(log.begin(), log.end(), '\r', '\n');
+  std::set<std::string> spar_misses;
+  const std::regex step_tag("^step [0-9]+/[0-9]+: ");
+  for (const std::string& line : linesOf(log)) {
+    if (line.find("its measured place is used") == std::string::npos) continue;
+    const std::string kind = std::regex_replace(std::regex_replace(line, step_tag, ""), number, "#");
+    EXPECT_TRUE(spar_misses.insert(kind).second) << "logged again: " << line;
+  }
 }
 
 // The viewer as built beside this sailshape (build/viewer/sailshape-viewer), or where
