@@ -41,10 +41,7 @@ const std::vector<CommandExamples>& examples() {
        {"sailshape compare --design main-design.obj --flying main.ply --no-segment --json compare.json",
         "sailshape compare --design main-design.obj --flying main.ply --no-segment --distances deviation.ply"}},
       {"demo", {"sailshape demo", "sailshape demo --dir demo-quick --steps 2 --scan-lines 300 --quiet"}},
-      {"db",
-       {"sailshape db init trials.db",
-        "sailshape db import trials.db main.json --sail 'Main 1' --sail-type mainsail --test Sheet --trim-step 1 "
-        "--awa 30"}},
+      {"db", {"sailshape db init trials.db", "sailshape db query trials.db --sections --csv"}},
       {"db init", {"sailshape db init trials.db"}},
       {"db import",
        {"sailshape db import trials.db main.json --sail 'Main 1' --sail-type mainsail --test Sheet --trim-step 1 "
