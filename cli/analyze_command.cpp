@@ -26,7 +26,7 @@ struct AnalyzeOptions {
   std::vector<double> at;
   std::string plane;
   std::string json_out, mesh_out, params_file, cloud_out;
-  bool print_params = false, no_segment = false, quiet = false, sky = false;
+  bool print_params = false, describe_params = false, no_segment = false, quiet = false, sky = false;
   int corners = -1;
   std::string scanner;  // lms111 / lms511: its beam footprint for the edges
 };
@@ -93,6 +93,10 @@ void run(const AnalyzeOptions& o) {
     std::cout << paramsToJson(params).dump(2) << "\n";
     return;
   }
+  if (o.describe_params) {
+    std::cout << describeParams(params);
+    return;
+  }
   if (o.input.empty()) throw InvalidInput("analyze: an INPUT cloud file is required");
 
   ProgressBar bar(!o.quiet);
@@ -119,6 +123,7 @@ void addAnalyzeCommand(CLI::App& app) {
   auto opt = std::make_shared<AnalyzeOptions>();
   CLI::App* cmd = app.add_subcommand(
       "analyze",
+      "Measure a flying sail from a cloud: its outline and sections (camber, draft, twist)\n\n"
       "Analyse a cloud of a flying sail (alone or in a scene with mast, boom and deck, in the boat frame): "
       "segment it, clean and smooth it, build its surface, find corners and edges, and cut sections with "
       "camber, draft, twist, entry and exit angles, each with its uncertainty. A scan that carries its samples' "
@@ -153,7 +158,12 @@ void addAnalyzeCommand(CLI::App& app) {
                 "returns from the sail alone while enough of it lies there, so the samples reach the edges and "
                 "--scanner's footprint moves nothing. Sets outline.edges_against_sky");
   cmd->add_flag("--no-segment", opt->no_segment, "The input is the sail alone: skip segmentation");
-  cmd->add_flag("--print-params", opt->print_params, "Print every pipeline parameter with its value and exit");
+  auto* print = cmd->add_flag("--print-params", opt->print_params,
+                              "Print every pipeline parameter with its value as JSON (a --params file) and exit");
+  cmd->add_flag("--describe-params", opt->describe_params,
+                "Print every pipeline parameter, one a line: its key (as --params files nest it), value, unit and "
+                "what it does; and exit")
+      ->excludes(print);
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress output");
   cmd->callback([opt] { run(*opt); });
 }

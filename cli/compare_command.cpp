@@ -178,6 +178,7 @@ void addCompareCommand(CLI::App& app) {
   auto opt = std::make_shared<CompareOptions>();
   CLI::App* cmd = app.add_subcommand(
       "compare",
+      "Compare a flying shape with its design: point distances and section deltas\n\n"
       "Compare a flying shape with its design, both in the boat frame: signed distance of every flying point to "
       "the design surface (positive to the sail's leeward side, the side its camber bulges to) with its "
       "statistics, and per-section parameter deltas (flying - design) at the same fractions.");

@@ -357,7 +357,8 @@ void runCheck(const DbOptions& o) {
 void addDbCommand(CLI::App& app) {
   auto o = std::make_shared<DbOptions>();
   CLI::App* db = app.add_subcommand(
-      "db", "The design-flying database (one SQLite file): store scans with their trim steps and analyses, query them, "
+      "db", "The design-flying database: store scans with their trim steps, query, export, check\n\n"
+            "The design-flying database (one SQLite file): store scans with their trim steps and analyses, query them, "
             "export, check and back up.");
   db->require_subcommand(1);
   auto add_db = [&](CLI::App* cmd) {
@@ -375,7 +376,7 @@ void addDbCommand(CLI::App& app) {
   });
 
   CLI::App* imp = db->add_subcommand(
-      "import", "Store one scan in one transaction: FILE is the JSON of `sailshape analyze --json` or a cloud file");
+      "import", "Store one scan (the JSON of `sailshape analyze --json`, or a cloud) in one transaction");
   add_db(imp);
   addImportOptions(imp, *o);
   imp->callback([o] { runImport(*o); });

@@ -10,10 +10,25 @@
 namespace sailshape::cli {
 namespace {
 
+namespace fs = std::filesystem;
+
 struct DemoCommandOptions {
   DemoOptions demo;
   bool quiet = false;
 };
+
+// The viewer as this build made it (beside this binary's folder: build/cli/sailshape and
+// build/viewer/sailshape-viewer), relative to the working folder when it lies below it;
+// where it is not there, the path README's build gives it.
+std::string viewerPath() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  const fs::path built = self.parent_path().parent_path() / "viewer" / "sailshape-viewer";
+  if (ec || !fs::exists(built, ec)) return "build/viewer/sailshape-viewer";
+  const fs::path relative = built.lexically_relative(fs::current_path(ec));
+  if (!ec && !relative.empty() && *relative.begin() != "..") return relative.string();
+  return built.string();
+}
 
 void printSummary(const DemoResult& r) {
   std::printf("\nScans (registration on the tunnel walls; truth = the emulator's real unit pose)\n");
@@ -30,14 +45,15 @@ void printSummary(const DemoResult& r) {
     std::printf("%-14s %4d %6.0f%% %8.1f (%+6.1f) %8.1f (%+6.1f) %8.1f (%+6.1f)\n", s.sail.c_str(), s.step,
                 100 * s.fraction, s.camber_pct, s.d_camber_pct, s.draft_pct, s.d_draft_pct, s.twist_deg, s.d_twist_deg);
   if (!r.warnings.empty()) {
-    std::printf("\nWarnings:\n");
-    for (const std::string& w : r.warnings) std::printf("  %s\n", w.c_str());
+    std::printf("\nWarnings (each once, with how often and at which trim steps it came):\n");
+    for (const std::string& w : summariseWarnings(r.warnings)) std::printf("  %s\n", w.c_str());
   }
   std::printf("\nDatabase:   %s\n", r.database.c_str());
   for (const std::string& p : r.reports) std::printf("Report:     %s\n", p.c_str());
   for (const std::string& u : r.unit_files) std::printf("Unit file:  %s\n", u.c_str());
   std::printf("Forces in the database are simulated by the emulator, not measured.\n");
-  std::printf("Finished in %.0f s. Open the results with:  sailshape-viewer %s\n", r.seconds, r.database.c_str());
+  std::printf("Finished in %.0f s. Open the results with:  %s %s\n", r.seconds, viewerPath().c_str(),
+              r.database.c_str());
 }
 
 }  // namespace
@@ -46,10 +62,12 @@ void addDemoCommand(CLI::App& app) {
   auto o = std::make_shared<DemoCommandOptions>();
   CLI::App* cmd = app.add_subcommand(
       "demo",
-      "Run the whole product on emulated hardware: two scanner units in a wind tunnel (LMS511 on the mainsail,\n"
-      "LMS111 on an A2 gennaker) sweep a test of trim steps through the real protocols (CoLa over TCP, the\n"
-      "turntable over a pseudo-terminal); each cloud is registered into the boat frame on the tunnel walls,\n"
-      "analysed, compared with its design and stored in DIR/sailshape.db, with the raw captures in DIR/captures.");
+      "Run the whole product on emulated scanners in a wind tunnel (the main job)\n\n"
+      "Run the whole product on emulated hardware: two scanner units in a wind tunnel (LMS511 on the mainsail, "
+      "LMS111 on an A2 gennaker) sweep a test of trim steps through the real protocols (CoLa over TCP, the "
+      "turntable over a pseudo-terminal); each cloud is registered into the boat frame on the tunnel walls, "
+      "analysed, compared with its design and stored in DIR/sailshape.db, with the raw captures in DIR/captures "
+      "and a PDF trim report per sail in DIR.");
   cmd->add_option("--dir", o->demo.dir, "Output folder (created; must not already hold a sailshape.db)")
       ->capture_default_str();
   cmd->add_option("--steps", o->demo.steps, "Trim steps; the gennaker tack is eased 20 mm (model scale) each step")

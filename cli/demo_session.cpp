@@ -1,5 +1,6 @@
 #include "cli/demo_session.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -396,8 +397,8 @@ void registerOnWalls(DemoRun& run, size_t i, const Sweep& sweep, const std::stri
   out.registration = registerToBoat(sweep.cloud, run.walls, bp, run.progress);
   const BoatRegistration& reg = out.registration;
   if (!reg.accepted)
-    run.result.warnings.push_back(tag + " " + u.config.name + ": wall registration not accepted (fitness " +
-                                  std::to_string(1000 * reg.fitness_rms_m) + " mm)");
+    run.result.warnings.push_back({out.row.step, u.config.name + ": wall registration not accepted (fitness " +
+                                                     std::to_string(1000 * reg.fitness_rms_m) + " mm)"});
   std::optional<RigidTransform>& stored = run.stored[i];
   if (!stored) {
     stored = reg.transform;
@@ -412,8 +413,8 @@ void registerOnWalls(DemoRun& run, size_t i, const Sweep& sweep, const std::stri
     const Drift d = compareTransforms(*stored, reg.transform, 5.0, tolerance_m);
     row.drift_mm = 1000 * d.max_displacement_m;
     if (d.moved) {
-      run.result.warnings.push_back(tag + " " + u.config.name + ": the unit moved (" + std::to_string(row.drift_mm) +
-                                    " mm); registered again");
+      run.result.warnings.push_back(
+          {row.step, u.config.name + ": the unit moved (" + std::to_string(row.drift_mm) + " mm); registered again"});
       stored = reg.transform;
     }
   }
@@ -424,18 +425,27 @@ void registerOnWalls(DemoRun& run, size_t i, const Sweep& sweep, const std::stri
 }
 
 // The spars where this cloud has them: the registration is good to a couple of
-// centimetres, as much as the gap between the mast and the luff.
-std::vector<Spar> findSpars(const DemoRun& run, const Cloud& boat_cloud, double sensor_sigma_m, const std::string& who) {
+// centimetres, as much as the gap between the mast and the luff. A spar this unit
+// cannot see is a warning of the step; the log says it the first time only, as
+// the unit stands still and misses it at every step.
+std::vector<Spar> findSpars(DemoRun& run, const Cloud& boat_cloud, double sensor_sigma_m, int step,
+                            const std::string& tag, const std::string& unit) {
   std::vector<Spar> spars;
   for (const Spar& nominal : run.spars) {
     SparFitParams fp;
     fp.sensor_sigma_m = sensor_sigma_m;
     const SparFit f = fitSpar(boat_cloud, nominal, fp);
-    if (f.found)
-      run.log(who + ": " + nominal.name + " found " +
+    if (f.found) {
+      run.log(tag + ": " + unit + ": " + nominal.name + " found " +
               std::to_string(static_cast<int>(std::lround(1000 * f.offset.norm()))) + " mm from its measured place");
-    else
-      run.log(who + ": " + f.message + "; its measured place is used");
+    } else {
+      const std::string text = unit + ": " + f.message + "; its measured place is used";
+      std::vector<StepWarning>& warnings = run.result.warnings;
+      const bool said =
+          std::any_of(warnings.begin(), warnings.end(), [&](const StepWarning& w) { return sameWarning(w.text, text); });
+      if (!said) run.log(tag + ": " + text);
+      warnings.push_back({step + 1, text});
+    }
     spars.push_back(f.spar);
   }
   return spars;
@@ -453,7 +463,7 @@ void analyseUnit(DemoRun& run, size_t i, int step, const Sweep& sweep, const std
   useScannerBeam(ap.outline, u.config.model);
   ap.outline.design_lengths_m = {u.design_sections.outline.luff_length_m, u.design_sections.outline.leech_length_m,
                                  u.design_sections.outline.foot_length_m};
-  const std::vector<Spar> spars = findSpars(run, out.boat_cloud, ap.sensor_sigma_m, tag + ": " + u.config.name);
+  const std::vector<Spar> spars = findSpars(run, out.boat_cloud, ap.sensor_sigma_m, step, tag, u.config.name);
   const double max_x = u.roi_ends_at_mast ? spars.front().base.x() : 1e9;
   // The whole scan loses its mixed pixels before the crop cuts off the surfaces behind
   // them that tell them apart (a sail's head seen against the other sail would keep a fringe).
@@ -464,7 +474,7 @@ void analyseUnit(DemoRun& run, size_t i, int step, const Sweep& sweep, const std
     out.analysis = analyzeSail(roi, ap, run.progress);
   } catch (const std::exception& e) {
     // The scan and its registration are still stored; the crew sees why there are no sections.
-    run.result.warnings.push_back(tag + " " + u.sail + ": analysis failed, scan stored without it: " + e.what());
+    run.result.warnings.push_back({step + 1, u.sail + ": analysis failed, scan stored without it: " + e.what()});
   }
   if (!out.analysis) {
     out.area_m2 = meshArea(u.design_mesh);
@@ -494,8 +504,8 @@ UnitStep processUnit(DemoRun& run, size_t i, int step, const std::string& tag, c
   row.points = s.cloud.size();
   row.partial = s.partial;
   row.start_spread_ms = spread_ms;
-  if (s.partial) run.result.warnings.push_back(tag + " " + u.config.name + ": partial sweep (" + s.message + ")");
-  for (const std::string& w : s.warnings) run.result.warnings.push_back(tag + " " + u.config.name + ": " + w);
+  if (s.partial) run.result.warnings.push_back({step + 1, u.config.name + ": partial sweep (" + s.message + ")"});
+  for (const std::string& w : s.warnings) run.result.warnings.push_back({step + 1, u.config.name + ": " + w});
   registerOnWalls(run, i, s, tag, out);
   analyseUnit(run, i, step, s, tag, out);
   return out;
@@ -556,7 +566,7 @@ void storeStep(DemoRun& run, Database& db, int step, const std::string& tag, con
     for (const SectionDelta& d : us.comparison.sections)
       run.result.sections.push_back({u.sail, step + 1, d.fraction, d.flying.camber_pct, d.flying.draft_pct,
                                      d.flying.twist_deg, d.delta.camber_pct, d.delta.draft_pct, d.delta.twist_deg});
-    for (const std::string& w : us.analysis->warnings) run.result.warnings.push_back(tag + " " + u.sail + ": " + w);
+    for (const std::string& w : us.analysis->warnings) run.result.warnings.push_back({step + 1, u.sail + ": " + w});
   }
 }
 
@@ -586,10 +596,10 @@ void writeReports(DemoRun& run) {
     try {
       const TrimReport report = writeTrimReport(rp, run.progress);
       run.result.reports.push_back(report.out_path);
-      for (const std::string& w : report.content.warnings) run.result.warnings.push_back("report " + u.sail + ": " + w);
+      for (const std::string& w : report.content.warnings) run.result.warnings.push_back({0, "report " + u.sail + ": " + w});
     } catch (const InvalidInput& e) {
       // A sail none of whose steps could be analysed has no sections to report.
-      run.result.warnings.push_back("no report for " + u.sail + ": " + e.what());
+      run.result.warnings.push_back({0, "no report for " + u.sail + ": " + e.what()});
     }
   }
 }

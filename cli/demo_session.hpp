@@ -10,12 +10,13 @@
 #include <vector>
 
 #include "analysis/core/progress.hpp"
+#include "cli/warning_summary.hpp"
 
 namespace sailshape::cli {
 
 struct DemoOptions {
   // Receives sailshape.db, the unit files, emulator-truth.json, the reports, captures/ and clouds/.
-  std::string dir = "sailshape-demo";
+  std::string dir = "demo-output";
   int steps = 3;                       // trim steps of the test (gennaker tack eased each step)
   int sections = 3;                    // per sail, SPEC §5 fractions k/(N+1)
   // Per sweep and unit: sets the turntable speed. 400 lines, 0.25° apart, give the upper
@@ -55,7 +56,7 @@ struct DemoResult {
   std::vector<std::string> unit_files;
   std::vector<DemoUnitStep> scans;
   std::vector<DemoSectionRow> sections;
-  std::vector<std::string> warnings;
+  std::vector<StepWarning> warnings;  // as raised, one per section, sail and step
   double seconds = 0;
 };
 

@@ -165,13 +165,16 @@ void runShow(const ShowOptions& o) {
 
 void addDesignCommand(CLI::App& app) {
   CLI::App* design = app.add_subcommand(
-      "design", "Design sails: generate a parametric design mesh (new), or read any design file and report its "
-                "dimensions and section parameters (show).");
+      "design",
+      "Generate a parametric design sail (new) or report on a design file (show)\n\n"
+      "Design sails: generate a parametric design mesh (new), or read any design file and report its "
+      "dimensions and section parameters (show).");
   design->require_subcommand(1);
 
   auto n = std::make_shared<NewOptions>();
   CLI::App* cmd = design->add_subcommand(
       "new",
+      "Generate a parametric design sail and write it as a mesh\n\n"
       "Generate a parametric design sail in the boat frame (+X forward, +Y port, +Z up, metres) and write it as a "
       "mesh. Unset options take the type's example values; profiles are given at the foot, mid-height and head "
       "and interpolated smoothly in between.");
@@ -222,6 +225,7 @@ void addDesignCommand(CLI::App& app) {
   auto s = std::make_shared<ShowOptions>();
   CLI::App* show = design->add_subcommand(
       "show",
+      "Report a design file's corners, edge lengths, area and section parameters\n\n"
       "Read a design (.dxf 3DFACE as Sailcut CAD exports it, .obj, .stl, .ply), bring it into the boat frame in "
       "metres, and report what was assumed, its corners, edge lengths, area and per-section parameters.");
   show->add_option("FILE", s->input, "Design file: .dxf, .obj, .stl or .ply")->required();

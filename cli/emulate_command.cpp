@@ -114,6 +114,7 @@ void addEmulateCommand(CLI::App& app) {
   auto o = std::make_shared<EmulateOptions>();
   CLI::App* cmd = app.add_subcommand(
       "emulate",
+      "Run an emulated scanner unit: SICK LMS111/LMS511 on TCP, its turntable on a pty\n\n"
       "Run an emulated scanner unit: a SICK LMS111/LMS511 speaking CoLa A/B on TCP (answering the start-up sequence "
       "as the recorded devices do and streaming LMDscandata) and its turntable on a pseudo-terminal, with ranges "
       "ray-cast into a scene through the sensor model of SPEC §3. Runs until Ctrl-C.");

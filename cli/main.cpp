@@ -6,11 +6,13 @@
 
 #include "analysis/core/errors.hpp"
 #include "cli/commands.hpp"
+#include "cli/help_format.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{
       "sailshape: measure flying sail shapes from laser scans and compare them with their design.\n"
       "Units are SI (metres); angles in degrees on the command line. Boat frame: +X forward, +Y port, +Z up."};
+  sailshape::cli::useHelpFormatter(app);  // before the commands: they take it from the app
   app.require_subcommand(1);
   app.set_version_flag("--version", "sailshape 0.1.0");
   sailshape::cli::addVerboseFlag(app);
@@ -26,6 +28,7 @@ int main(int argc, char** argv) {
   sailshape::cli::addEmulateCommand(app);
   sailshape::cli::addScanCommand(app);
   sailshape::cli::addScannerCommand(app);
+  sailshape::cli::addExamples(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

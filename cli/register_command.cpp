@@ -223,6 +223,7 @@ void addRegisterCommand(CLI::App& app) {
   auto opt = std::make_shared<RegisterOptions>();
   CLI::App* cmd = app.add_subcommand(
       "register",
+      "Register one unit's cloud into another unit's frame, or a cloud into the boat frame\n\n"
       "Register one unit's cloud into another unit's frame (--reference, --moving) and/or the reference cloud into "
       "the boat frame (--boat-reference). Prints the 4x4 transform (four lines of four numbers: x_ref = T x_moving) "
       "on stdout; fails without writing it when the fit is not below the sensor uncertainty.");

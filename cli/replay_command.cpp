@@ -68,6 +68,7 @@ void addReplayCommand(CLI::App& app) {
   auto opt = std::make_shared<ReplayOptions>();
   CLI::App* cmd = app.add_subcommand(
       "replay",
+      "Decode an archived scanner capture again: summary, frames or a recalibrated cloud\n\n"
       "Decode an archived scanner session again: a sailshape capture (.sscap, written during scans) or a "
       "pcapng-JSON recording of SICK CoLa traffic. Prints a summary; --json writes every LMDscandata frame; --unit "
       "with --cloud turns the frames into a cloud with a new calibration.");

@@ -33,6 +33,7 @@ void addReportCommand(CLI::App& app) {
   auto opt = std::make_shared<ReportOptions>();
   CLI::App* cmd = app.add_subcommand(
       "report",
+      "Write a PDF trim report of one scan or of a test's trim steps from the database\n\n"
       "Write a PDF trim report of one scan or of a test's trim steps from the database: a cover with boat, sail, "
       "campaign, conditions and units; 3D views of the design (blue grid) and the flying shape (red) from the side, "
       "above and astern with the signed deviation as a colour map in mm; the section table (camber, draft, twist, "

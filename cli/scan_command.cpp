@@ -144,6 +144,7 @@ void addScanCommand(CLI::App& app) {
   auto o = std::make_shared<ScanOptions>();
   CLI::App* cmd = app.add_subcommand(
       "scan",
+      "Sweep scanner units and write their clouds, samples and raw captures\n\n"
       "Sweep scanner units: home each turntable, move to the start angle, stream scans while rotating through the "
       "sweep angle, stop. Writes per unit NAME.ply (cloud by SPEC §2 with the unit's p, θ and pose), "
       "NAME.samples.csv (r, α, β, RSSI, time per point), NAME.sscap (raw telegrams, for `sailshape replay`) and "

@@ -121,11 +121,15 @@ void run(const CalibrateOptions& o) {
 }  // namespace
 
 void addScannerCommand(CLI::App& app) {
-  CLI::App* scanner = app.add_subcommand("scanner", "Scanner unit maintenance");
+  CLI::App* scanner = app.add_subcommand(
+      "scanner", "Scanner unit maintenance: calibrate a unit's p and θ from sweeps of known shapes\n\n"
+                 "Its command calibrate fits p and θ (SPEC §2) by least squares to sweeps of planes, and of "
+                 "cylinders of known radius.");
   scanner->require_subcommand(1);
   auto o = std::make_shared<CalibrateOptions>();
   CLI::App* cmd = scanner->add_subcommand(
       "calibrate",
+      "Estimate a unit's geometric constants p and θ from sweeps of known shapes\n\n"
       "Estimate the unit's geometric constants p and θ (SPEC §2) by least squares from sweeps of known shapes: "
       "planes of unknown position (a tunnel wall, the floor) and optionally cylinders of known radius. Two planes "
       "at an angle, seen over a wide β range, determine θ best; standard errors and a warning show a weak set-up.");

@@ -64,6 +64,7 @@ void addSimulateCommand(CLI::App& app) {
   auto opt = std::make_shared<SimulateOptions>();
   CLI::App* cmd = app.add_subcommand(
       "simulate",
+      "Write a synthetic scan of a generated sail with known section parameters\n\n"
       "Write a synthetic scan of a generated sail with known section parameters (for trying the pipeline "
       "and checking it against the truth).");
   cmd->add_option("--type", opt->type, "Sail type: main, square-top, jib or gennaker")

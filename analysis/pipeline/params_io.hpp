@@ -10,6 +10,10 @@ namespace sailshape {
 
 nlohmann::json paramsToJson(const AnalysisParams& params);
 
+// One line per parameter, in paramsToJson's order: its dotted key
+// ("region_growing.k_neighbours"), value (as JSON), unit and what it does.
+std::string describeParams(const AnalysisParams& params);
+
 // Starts from the defaults and overrides what the document sets. Throws
 // InvalidInput naming an unknown key ("region_growing.k_neighbors") or a value
 // of the wrong type.

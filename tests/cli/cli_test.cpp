@@ -65,6 +65,150 @@ TEST_F(Cli, HelpListsTheSubcommands) {
   expectMentions(r.out, {"analyze", "simulate", "--help", "--version"});
 }
 
+// The names a help lists under "Subcommands:", one per line up to the blank line after them.
+std::vector<std::string> subcommandsListed(const std::string& help) {
+  std::vector<std::string> names;
+  bool in_list = false;
+  for (const std::string& line : lines(help)) {
+    if (line == "Subcommands:") {
+      in_list = true;
+    } else if (in_list && line.empty()) {
+      break;
+    } else if (in_list) {
+      std::istringstream words(line);
+      std::string name;
+      words >> name;
+      names.push_back(name);
+    }
+  }
+  return names;
+}
+
+// Every command reachable from `sailshape --help`, by its words after `sailshape`
+// ("" for sailshape itself), with its help; `sailshape` runs in `dir`.
+void collectHelps(const fs::path& dir, const std::string& path, std::vector<std::pair<std::string, std::string>>& out) {
+  const Outcome r = sailshape::testing::runSailshape(dir, path + (path.empty() ? "" : " ") + "--help");
+  ASSERT_EQ(r.exit_code, 0) << path << ": " << r.err;
+  out.emplace_back(path, r.out);
+  for (const std::string& name : subcommandsListed(r.out)) collectHelps(dir, path.empty() ? name : path + " " + name, out);
+}
+
+TEST_F(Cli, EveryCommandsHelpEndsWithExamplesOfItself) {
+  std::vector<std::pair<std::string, std::string>> helps;
+  collectHelps(dir_, "", helps);
+  // sailshape, its 12 commands, design's 2, db's 8 and scanner's 1.
+  ASSERT_EQ(helps.size(), 24u);
+  for (const auto& [path, help] : helps) {
+    const size_t examples = help.find("\nExamples:\n");
+    ASSERT_NE(examples, std::string::npos) << "`sailshape " << path << " --help` has no examples:\n" << help;
+    // Each example (a line "  sailshape ...", continued after a trailing backslash) runs this very command.
+    int count = 0;
+    for (const std::string& line : lines(help.substr(examples + 11))) {
+      if (line.rfind("  sailshape", 0) != 0) continue;
+      ++count;
+      EXPECT_EQ(line.rfind("  sailshape " + path, 0), 0u) << "an example of `" << path << "` runs another command: " << line;
+    }
+    EXPECT_GE(count, 1) << path;
+    EXPECT_LE(count, 2) << path;
+  }
+}
+
+// The example command lines of a help, each whole (joined where a trailing backslash continues it).
+std::vector<std::string> examplesOf(const std::string& help) {
+  std::vector<std::string> out;
+  const size_t at = help.find("\nExamples:\n");
+  if (at == std::string::npos) return out;
+  bool continued = false;
+  for (const std::string& line : lines(help.substr(at + 11))) {
+    const bool more = line.size() >= 2 && line.compare(line.size() - 2, 2, " \\") == 0;
+    const std::string text = more ? line.substr(0, line.size() - 2) : line;
+    if (continued)
+      out.back() += " " + text.substr(text.find_first_not_of(' '));
+    else if (text.rfind("  sailshape", 0) == 0)
+      out.push_back(text.substr(2));
+    continued = more;
+  }
+  return out;
+}
+
+// The examples of the commands that need no scanner or demo run, run as written in
+// the order the help lists them, from a folder with the source tree's assets/:
+// each works, on the files the ones before it wrote.
+TEST_F(Cli, ExamplesRunAsWritten) {
+  fs::create_directory_symlink(fs::path(SAILSHAPE_ASSETS), dir_ / "assets");
+  const std::string bin_dir = fs::path(SAILSHAPE_BIN).parent_path().string();
+  int ran = 0;
+  for (const char* command : {"analyze", "simulate", "design", "design new", "design show", "compare", "db", "db init",
+                              "db import", "db list", "db show", "db query", "db export", "db check", "db backup"}) {
+    const Outcome help = sailshape(std::string(command) + " --help");
+    for (const std::string& example : examplesOf(help.out)) {
+      if (example.find("demo-output") != std::string::npos) continue;  // needs `sailshape demo` first
+      const std::string cmd = "cd '" + dir_.string() + "' && PATH='" + bin_dir + "':\"$PATH\" " + example +
+                              " >example-out.txt 2>example-err.txt </dev/null";
+      const int status = std::system(cmd.c_str());
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+          << example << "\n" << readText(dir_ / "example-err.txt");
+      ++ran;
+    }
+  }
+  EXPECT_GE(ran, 25);
+  EXPECT_TRUE(fs::exists(dir_ / "trials-backup.db"));
+  EXPECT_TRUE(fs::exists(dir_ / "sections.csv"));
+}
+
+TEST_F(Cli, CommandListsHaveOneShortLinePerCommand) {
+  const Outcome top = sailshape("--help");
+  ASSERT_EQ(top.exit_code, 0) << top.err;
+  for (const std::string& line : lines(top.out)) EXPECT_LE(line.size(), 120u) << line;
+  EXPECT_EQ(subcommandsListed(top.out).size(), 12u) << top.out;
+
+  // The details stay in the command's own help: analyze's tells of mixed pixels, its line in the list does not.
+  const Outcome analyze = sailshape("analyze --help");
+  EXPECT_NE(analyze.out.find("mixed pixels"), std::string::npos) << analyze.out;
+  EXPECT_EQ(top.out.find("mixed pixels"), std::string::npos) << top.out;
+  // Every list of subcommands (db's, design's, scanner's) keeps to a line each.
+  for (const char* parent : {"db", "design", "scanner"}) {
+    const Outcome r = sailshape(std::string(parent) + " --help");
+    bool in_list = false;
+    for (const std::string& line : lines(r.out)) {
+      in_list = line == "Subcommands:" || (in_list && !line.empty());
+      if (in_list) {
+        EXPECT_LE(line.size(), 120u) << parent << ": " << line;
+      }
+    }
+  }
+}
+
+// README's entry for a command: the bullet "- `sailshape NAME ..." up to the next bullet.
+std::string readmeEntry(const std::string& readme, const std::string& name) {
+  const size_t start = readme.find("\n- `sailshape " + name + " ");
+  if (start == std::string::npos) return "";
+  const size_t end = readme.find("\n- ", start + 1);
+  return readme.substr(start, end == std::string::npos ? std::string::npos : end - start);
+}
+
+TEST_F(Cli, ReadmeNamesTheOptionsAndTheDemosDefaultFolder) {
+  const std::string readme = readText(fs::path(SAILSHAPE_ASSETS) / ".." / "README.md");
+  ASSERT_FALSE(readme.empty());
+  EXPECT_NE(readmeEntry(readme, "simulate").find("--points N"), std::string::npos) << readmeEntry(readme, "simulate");
+  const std::string db = readmeEntry(readme, "db");
+  EXPECT_NE(db.find("`db import DB FILE`"), std::string::npos) << db;
+  EXPECT_NE(db.find("`--test NAME`"), std::string::npos) << db;
+  EXPECT_NE(readmeEntry(readme, "analyze").find("--describe-params"), std::string::npos);
+
+  // The folder `sailshape demo` writes to unless told: the one README (and scripts/demo) name.
+  const Outcome help = sailshape("demo --help");
+  const size_t at = help.out.find("--dir TEXT=");
+  ASSERT_NE(at, std::string::npos) << help.out;
+  std::istringstream rest(help.out.substr(at + 11));
+  std::string folder;
+  rest >> folder;
+  EXPECT_EQ(folder, "demo-output");
+  EXPECT_NE(readmeEntry(readme, "demo").find("(default `" + folder + "`"), std::string::npos)
+      << readmeEntry(readme, "demo");
+  EXPECT_NE(readText(fs::path(SAILSHAPE_ASSETS) / ".." / "scripts" / "demo").find("out=" + folder), std::string::npos);
+}
+
 TEST_F(Cli, AnalyzeHelpMentionsEveryOption) {
   const Outcome r = sailshape("analyze --help");
   EXPECT_EQ(r.exit_code, 0) << r.err;
@@ -152,6 +296,60 @@ TEST_F(Cli, PrintParamsShowsAParameterFileAndTheOptionsApplied) {
   const Outcome sky = sailshape("analyze --scanner lms511 --sky --print-params");
   ASSERT_EQ(sky.exit_code, 0) << sky.err;
   EXPECT_EQ(json::parse(sky.out)["outline"]["edges_against_sky"], true);
+}
+
+// Flattens a parameter document into its dotted keys, as --describe-params names them.
+void dottedKeys(const json& doc, const std::string& prefix, std::vector<std::pair<std::string, json>>& out) {
+  for (auto it = doc.begin(); it != doc.end(); ++it) {
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (it.value().is_object())
+      dottedKeys(it.value(), key, out);
+    else
+      out.emplace_back(key, it.value());
+  }
+}
+
+TEST_F(Cli, DescribeParamsGivesEveryParameterItsValueUnitAndMeaning) {
+  const Outcome r = sailshape("analyze --sections 5 --scanner lms511 --describe-params");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::pair<std::string, json>> keys;
+  dottedKeys(sailshape::paramsToJson(sailshape::AnalysisParams{}), "", keys);
+  const std::vector<std::string> out = lines(r.out);
+  ASSERT_EQ(out.size(), keys.size()) << r.out;
+  for (size_t k = 0; k < keys.size(); ++k) {
+    std::istringstream words(out[k]);
+    std::string key, value, unit, first_word;
+    words >> key >> value >> unit >> first_word;
+    EXPECT_EQ(key, keys[k].first) << out[k];
+    EXPECT_FALSE(first_word.empty()) << "no description: " << out[k];
+    EXPECT_NE(unit, "?") << "no unit: " << out[k];
+    EXPECT_EQ(out[k].find("(no description)"), std::string::npos) << out[k];
+  }
+  // The options given are applied, as --print-params shows them; units as SPEC and the names say.
+  auto line = [&](const std::string& key) {
+    for (const std::string& l : out)
+      if (l.rfind(key + " ", 0) == 0) return l;
+    return std::string();
+  };
+  std::istringstream count(line("sections.count"));
+  std::string key, value;
+  count >> key >> value;
+  EXPECT_EQ(value, "5");
+  std::istringstream beam(line("outline.beam_exit_diameter_m"));
+  std::string unit;
+  beam >> key >> value >> unit;
+  EXPECT_EQ(value, "0.013");
+  EXPECT_EQ(unit, "m");
+  std::istringstream sigma(line("sensor_sigma_m"));
+  sigma >> key >> value >> unit;
+  EXPECT_EQ(value, "0.004");
+  EXPECT_EQ(unit, "m");
+  std::istringstream angle(line("region_growing.max_normal_angle_deg"));
+  angle >> key >> value >> unit;
+  EXPECT_EQ(unit, "deg");
+
+  // The JSON form stays what --params files read; the two cannot be asked for together.
+  EXPECT_EQ(sailshape("analyze --print-params --describe-params").exit_code, 2);
 }
 
 TEST_F(Cli, SimulatedMainIsMeasuredWithinHalfAPercentOfCamber) {

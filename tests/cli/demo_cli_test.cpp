@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,9 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -43,7 +47,8 @@ class DemoRun : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("sailshape-demo-test-" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    outcome_ = runSailshape(dir_, "demo --dir '" + (dir_ / "out").string() + "' --steps 2 --scan-lines 300 --quiet");
+    // Not --quiet: its stage log on stderr is checked too.
+    outcome_ = runSailshape(dir_, "demo --dir '" + (dir_ / "out").string() + "' --steps 2 --scan-lines 300");
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
@@ -60,6 +65,77 @@ TEST_F(DemoRun, FinishesAndSaysWhereEverythingIs) {
   EXPECT_NE(outcome_.out.find("simulated"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir_ / "out" / "tunnel-main-lms511.json"));
   EXPECT_TRUE(fs::exists(dir_ / "out" / "tunnel-gennaker-lms111.json"));
+}
+
+std::vector<std::string> linesOf(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+// Each warning is said once per run: the same one at every trim step (or for every
+// section, differing in its numbers only) is one line with how often and where it came.
+TEST_F(DemoRun, SaysEachWarningOnce) {
+  ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
+  std::vector<std::string> warnings;
+  bool in_block = false;
+  for (const std::string& line : linesOf(outcome_.out)) {
+    if (line.rfind("Warnings", 0) == 0) {
+      in_block = true;
+    } else if (in_block && line.empty()) {
+      break;
+    } else if (in_block) {
+      warnings.push_back(line);
+    }
+  }
+  const std::regex number("-?[0-9]+(\\.[0-9]+)?(–-?[0-9]+(\\.[0-9]+)?)?");
+  const std::regex where(" \\(([0-9]+) times, steps? [0-9, –]+\\)$| \\(step [0-9]+\\)$");
+  std::set<std::string> kinds;
+  int too_few = 0;
+  for (const std::string& w : warnings) {
+    EXPECT_NE(w.rfind("  step ", 0), 0u) << "the step goes to the end: " << w;
+    const std::string kind = std::regex_replace(w, number, "#");
+    EXPECT_TRUE(kinds.insert(kind).second) << "said twice: " << w << "\n" << outcome_.out;
+    std::smatch m;
+    if (w.find("report") == std::string::npos) {
+      EXPECT_TRUE(std::regex_search(w, m, where)) << "no step: " << w;
+      if (m[1].matched) {
+        EXPECT_GE(std::stoi(m[1]), 2) << w;
+      }
+    }
+    too_few += w.find("too few within") != std::string::npos;
+  }
+  // The end-angle warning comes per section, end and step; said once per sail and end.
+  EXPECT_LE(too_few, 4) << outcome_.out;
+
+  // A spar a unit cannot see, it misses at every step: the stage log says so once.
+  std::string log = outcome_.err;
+  std::replace(log.begin(), log.end(), '\r', '\n');
+  std::set<std::string> spar_misses;
+  const std::regex step_tag("^step [0-9]+/[0-9]+: ");
+  for (const std::string& line : linesOf(log)) {
+    if (line.find("its measured place is used") == std::string::npos) continue;
+    const std::string kind = std::regex_replace(std::regex_replace(line, step_tag, ""), number, "#");
+    EXPECT_TRUE(spar_misses.insert(kind).second) << "logged again: " << line;
+  }
+}
+
+// The viewer as built beside this sailshape (build/viewer/sailshape-viewer), or where
+// README's build puts it: a path that opens it, not a name off PATH.
+TEST_F(DemoRun, NamesTheViewerByItsPath) {
+  ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
+  const size_t at = outcome_.out.find("Open the results with:");
+  ASSERT_NE(at, std::string::npos) << outcome_.out;
+  std::istringstream rest(outcome_.out.substr(at + 22));
+  std::string viewer, db;
+  rest >> viewer >> db;
+  EXPECT_EQ(db, (dir_ / "out" / "sailshape.db").string());
+  const fs::path built = fs::path(SAILSHAPE_BIN).parent_path().parent_path() / "viewer" / "sailshape-viewer";
+  if (fs::exists(built))
+    EXPECT_TRUE(fs::equivalent(fs::absolute(viewer), built)) << viewer << " vs " << built;
+  else
+    EXPECT_EQ(viewer, "build/viewer/sailshape-viewer");
 }
 
 TEST_F(DemoRun, StoresEverySweepWithItsRegistrationAndCapture) {
