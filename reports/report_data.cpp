@@ -19,21 +19,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 void loadContext(Database& db, int64_t trim_step_id, ReportData& data) {
   std::optional<TrimStepContext> c = trimStepContext(db, trim_step_id);
   if (!c) throw InvalidInput("[loadReport] trim step " + std::to_string(trim_step_id) + " not found");
-  data.campaign = std::move(c->campaign);
-  data.campaign_kind = std::move(c->campaign_kind);
-  data.place = std::move(c->place);
-  data.campaign_start = std::move(c->campaign_start);
-  data.session = std::move(c->session);
-  data.session_started = std::move(c->session_started);
-  data.boat = std::move(c->boat);
-  data.boat_class = std::move(c->boat_class);
-  data.sail = std::move(c->sail);
-  data.sail_type = std::move(c->sail_type);
-  data.size_variant = std::move(c->size_variant);
-  data.designer = std::move(c->designer);
-  data.version = std::move(c->version);
-  data.design_mesh = std::move(c->design_mesh);
-  data.test = std::move(c->test);
+  static_cast<TrimStepContext&>(data) = std::move(*c);
 }
 
 // The outline stored with an analysis: `sail` as `sailshape analyze --json` writes

@@ -13,6 +13,7 @@
 #include "analysis/sections/luff_curve.hpp"
 #include "analysis/sections/sections.hpp"
 #include "database/sqlite.hpp"
+#include "database/trim_step.hpp"
 
 namespace sailshape {
 
@@ -54,13 +55,11 @@ struct ReportStep {
   Cloud cloud;                             // the stored cloud; empty when none was stored
 };
 
-struct ReportData {
-  std::string campaign, campaign_kind, place, campaign_start, session, session_started;
-  std::string boat, boat_class;
-  std::string sail, sail_type, size_variant, designer, version;
-  std::string test;                        // empty for a single scan without a test
-  std::optional<Mesh> design_mesh;         // the sail's stored design, when there is one
-  std::vector<ReportStep> steps;           // one per trim step, in step order
+// Where the report's trim steps belong (campaign, session, boat, sail, test: empty
+// for a single scan without one; the sail's stored design, when there is one) and
+// the steps themselves.
+struct ReportData : TrimStepContext {
+  std::vector<ReportStep> steps;  // one per trim step, in step order
 };
 
 // The scan `scan_id` with its trim step, sail and latest analysis. Throws
