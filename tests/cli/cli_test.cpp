@@ -550,4 +550,32 @@ TEST_F(Cli, CompareNamesASectionTheFlyingScanCouldNotMeasure) {
       << r.out;
 }
 
+// The tree as the README draws it: every analysis sub-library is a folder with a
+// README and a CMake target, named in the README's layout table, and no source file
+// in analysis/ is longer than a reader can hold (about 900 lines).
+TEST(Layout, EveryAnalysisFolderHasAReadmeARowInTheLayoutTableAndNoFileOver900Lines) {
+  const fs::path root = fs::path(SAILSHAPE_ASSETS) / "..";
+  const std::string readme = readText(root / "README.md");
+  ASSERT_FALSE(readme.empty());
+  size_t folders = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(root / "analysis")) {
+    if (!e.is_directory()) continue;
+    ++folders;
+    const std::string name = e.path().filename().string();
+    EXPECT_TRUE(fs::exists(e.path() / "README.md")) << name;
+    EXPECT_TRUE(fs::exists(e.path() / "CMakeLists.txt")) << name;
+    EXPECT_NE(readme.find("| `analysis/" + name + "/` |"), std::string::npos) << name << " is not in the layout table";
+    for (const fs::directory_entry& f : fs::directory_iterator(e.path())) {
+      const std::string ext = f.path().extension().string();
+      if (ext != ".cpp" && ext != ".hpp") continue;
+      std::ifstream in(f.path());
+      size_t lines = 0;
+      for (std::string line; std::getline(in, line);) ++lines;
+      EXPECT_LE(lines, 900u) << f.path();
+    }
+  }
+  EXPECT_GE(folders, 10u);
+  EXPECT_TRUE(fs::exists(root / "tests" / "support" / "README.md"));
+}
+
 }  // namespace
