@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/plausible.hpp"
 #include "database/cloud_blob.hpp"
 
 namespace sailshape {
@@ -45,6 +46,19 @@ void requireFinite(const std::optional<double>& v, const char* name) {
     throw InvalidInput(std::string("[importScan] ") + name + " must be finite (got " + std::to_string(*v) + ")");
 }
 
+// The sail's lengths and area as the analysis JSON gives them: a number no measured
+// sail can have (a cloud scaled by 1e30, a cloud in millimetres) is refused, not stored.
+void refuseImplausibleSail(const nlohmann::json& sail, const char* function) {
+  if (!sail.is_object()) return;
+  for (const char* key : {"luff_length_m", "leech_length_m", "foot_length_m", "top_length_m", "area_m2"}) {
+    const std::optional<double> v = measured(sail, key, "sail", function);
+    if (!v) continue;
+    const bool area = std::string(key) == "area_m2";
+    const auto why = area ? implausibleArea(*v, std::string("sail.") + key) : implausibleLength(*v, std::string("sail.") + key);
+    if (why) throw InvalidInput(std::string("[") + function + "] " + *why);
+  }
+}
+
 // Writes the analysis row and its sections; the caller holds the transaction.
 int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, const std::string& software_version,
                       const char* function, size_t* sections_written, const ImportHook& hook) {
@@ -56,6 +70,7 @@ int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, 
   };
   json_or_null(3, "parameters");
   nlohmann::json sail = doc.value("sail", nlohmann::json::object());
+  refuseImplausibleSail(sail, function);
   if (doc.contains("luff")) sail["luff"] = doc["luff"];
   a.bind(4, sail.dump());
   // Sections asked for but not measured ride in the diagnostics: the sections table

@@ -11,6 +11,7 @@
 #include <lzf.h>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/plausible.hpp"
 #include "analysis/io/ply_format.hpp"
 #include "analysis/io/text_scan.hpp"
 
@@ -741,9 +742,11 @@ CloudReadResult readCloud(const std::string& path) {
   const bool known = ext == ".ply" || ext == ".pcd" || ext == ".xyz" || ext == ".txt" || ext == ".csv";
   if (!known) throw unknownExtension(path);
   const std::string buf = readWholeFile(path);
-  if (ext == ".ply") return readPly(path, buf);
-  if (ext == ".pcd") return readPcd(path, buf);
-  return readText(path, buf, ext == ".csv" ? "csv" : "xyz");
+  CloudReadResult read = ext == ".ply"   ? readPly(path, buf)
+                         : ext == ".pcd" ? readPcd(path, buf)
+                                         : readText(path, buf, ext == ".csv" ? "csv" : "xyz");
+  if (auto why = implausibleCoordinates(read.cloud.points, "the cloud")) throw FileError(path + ": " + *why);
+  return read;
 }
 
 void writeCloud(const std::string& path, const Cloud& cloud, CloudFormat format) {

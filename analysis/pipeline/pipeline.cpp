@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/core/plausible.hpp"
 #include "analysis/spatial/principal_axes.hpp"
 
 namespace sailshape {
@@ -243,6 +244,7 @@ void checkAnalysisParams(const Cloud& input, const AnalysisParams& p) {
   for (size_t i = 0; i < input.size(); ++i)
     if (!input.points[i].allFinite())
       throw InvalidInput("[analyzeSail] point " + std::to_string(i) + " has a non-finite coordinate");
+  if (auto why = implausibleCoordinates(input.points, "the cloud")) throw InvalidInput("[analyzeSail] " + *why);
   if (!(p.sensor_sigma_m > 0))
     throw InvalidInput("[analyzeSail] sensor_sigma_m must be > 0 (got " + std::to_string(p.sensor_sigma_m) + ")");
   if (!(p.working_voxel_sigmas >= 0) || !std::isfinite(p.working_voxel_sigmas))
@@ -438,6 +440,27 @@ void measureSections(const AnalysisParams& p, SailAnalysis& a) {
   t.finish(a.sections.sections.size(), a.sections.warnings);
 }
 
+// A length, area or section value that is not a number, or that no measured sail
+// has, is a failure of the analysis to say so, not a result to report.
+void refuseImplausibleResults(const SailAnalysis& a) {
+  const SailOutline& o = a.outline;
+  const std::pair<double, const char*> lengths[] = {{o.luff_length_m, "the luff"},
+                                                    {o.leech_length_m, "the leech"},
+                                                    {o.foot_length_m, "the foot"},
+                                                    {o.top_length_m, "the top edge"}};
+  for (const auto& [value, name] : lengths)
+    if (auto why = implausibleLength(value, name)) throw AnalysisError("[analyzeSail] " + *why);
+  if (auto why = implausibleArea(o.area_m2, "the area")) throw AnalysisError("[analyzeSail] " + *why);
+  for (const Vec3& c : {o.tack, o.clew, o.head, o.peak})
+    if (!c.allFinite()) throw AnalysisError("[analyzeSail] a corner's position is not a number");
+  for (const Section& s : a.sections.sections) {
+    const SectionParameters& v = s.value;
+    for (double x : {v.chord_m, v.camber_pct, v.draft_pct, v.twist_deg, v.entry_deg, v.exit_deg})
+      if (!std::isfinite(x))
+        throw AnalysisError("[analyzeSail] section " + formatFixed(s.fraction, 2) + " has a value that is not a number");
+  }
+}
+
 }  // namespace
 
 SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
@@ -475,6 +498,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
   meshSurface(cloud, p, progress, a, loose);
   outlineSail(input, sail_scan, working.scan_points, p, a, loose);
   measureSections(p, a);
+  refuseImplausibleResults(a);
   progress("done", 1.0);
   a.sail_cloud = std::move(cloud);
   return a;

@@ -254,6 +254,26 @@ TEST_F(Cli, AGarbagePlyIsOneClearLine) {
   EXPECT_NE(err[0].find(broken), std::string::npos) << err[0];
 }
 
+// A cloud in millimetres, or scaled far beyond any scanner's reach, is one line naming
+// what is wrong, before any analysis (which would report a 62-digit area).
+TEST_F(Cli, ACloudNoScannerCouldMeasureIsOneLine) {
+  const std::string mm = path("main_mm.xyz");
+  std::ofstream(mm) << "0 0 1000\n-500 0 12400\n-3600 0 1300\n-1500 200 6000\n";
+  Outcome r = sailshape("analyze " + mm);
+  EXPECT_NE(r.exit_code, 0);
+  auto err = lines(r.err);
+  ASSERT_EQ(err.size(), 1u) << r.err;
+  EXPECT_NE(err[0].find(mm + ": the cloud looks like millimetres"), std::string::npos) << err[0];
+  const std::string huge = path("huge.xyz");
+  std::ofstream(huge) << "0 0 1e30\n-5e29 0 1.24e31\n-3.6e30 0 1.3e30\n";
+  r = sailshape("analyze " + huge);
+  EXPECT_NE(r.exit_code, 0);
+  err = lines(r.err);
+  ASSERT_EQ(err.size(), 1u) << r.err;
+  EXPECT_NE(err[0].find("reaches 1.24e+31 m from the origin"), std::string::npos) << err[0];
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
 TEST_F(Cli, BadArgumentsAreOneLineWithExitCodeTwo) {
   Outcome r = sailshape("analyze --sections 0 " + path("x.ply"));  // range 1..100
   EXPECT_EQ(r.exit_code, 2);

@@ -356,6 +356,28 @@ TEST_F(DbCli, WrongTypedValueRefusesTheImportNamingFieldAndSection) {
   EXPECT_TRUE(rows[2]["camber_pct"].is_null()) << rows[2].dump();
 }
 
+// An analysis of a cloud scaled by 1e30 (a 62-digit area) is no sail's: refused with
+// its field named, nothing stored.
+TEST_F(DbCli, ASailNoScanCouldMeasureIsRefused) {
+  ASSERT_EQ(run("db init " + db_).exit_code, 0);
+  nlohmann::json doc = nlohmann::json::parse(readText(analysisJson(8)));
+  doc["sail"]["area_m2"] = 3.7e62;
+  const fs::path file = dir_ / "huge.json";
+  std::ofstream(file) << doc.dump();
+  Outcome o = run("db import " + db_ + " " + file.string());
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err.rfind("sailshape: error: sail.area_m2 of 3.7e+62 m² is no sail's", 0), 0u) << o.err;
+  EXPECT_EQ(countLines(o.err), 1) << o.err;
+  doc["sail"]["area_m2"] = 20.0;
+  doc["sail"]["luff_length_m"] = 12400.0;  // millimetres
+  std::ofstream(file, std::ios::trunc) << doc.dump();
+  o = run("db import " + db_ + " " + file.string());
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_EQ(o.err.rfind("sailshape: error: sail.luff_length_m of 12400.0 m is no sail's", 0), 0u) << o.err;
+  o = run("db list " + db_ + " --csv");
+  EXPECT_EQ(countLines(o.out), 1) << o.out;  // the header only
+}
+
 TEST_F(DbCli, ErrorsNameTheInternalFunctionOnlyWithVerbose) {
   const std::string notes = (dir_ / "notes.db").string();
   std::ofstream(notes) << "not a database, just a long enough line of text to fill a header\n";

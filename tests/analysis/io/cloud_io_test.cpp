@@ -238,12 +238,12 @@ TEST_F(CloudIoTest, PlyBigEndianWithMixedTypes) {
       "element vertex 2\nproperty float32 x\nproperty float64 y\nproperty int16 z\n"
       "property uint8 reflectance\nproperty ushort ring\nend_header\n");
   b.be(1.25f).be(-2.5).be(int16_t{-7}).be(uint8_t{200}).be(uint16_t{3});
-  b.be(0.5f).be(1e-9).be(int16_t{300}).be(uint8_t{1}).be(uint16_t{4});
+  b.be(0.5f).be(1e-9).be(int16_t{-170}).be(uint8_t{1}).be(uint16_t{4});
   const CloudReadResult r = readCloud(write("be.ply", b.data));
   EXPECT_EQ(r.format, "ply-binary");
   ASSERT_EQ(r.cloud.size(), 2u);
   EXPECT_EQ(r.cloud.points[0], Vec3(1.25, -2.5, -7));
-  EXPECT_EQ(r.cloud.points[1], Vec3(0.5, 1e-9, 300));
+  EXPECT_EQ(r.cloud.points[1], Vec3(0.5, 1e-9, -170));  // two bytes, sign-extended
   EXPECT_EQ(r.cloud.intensity, (std::vector<float>{200, 1}));
   EXPECT_FALSE(r.cloud.hasScanAngles());
   ASSERT_TRUE(r.cloud.viewpoint.has_value());
@@ -565,6 +565,17 @@ TEST_F(CloudIoTest, XyzWithoutHeader) {
 
   const CloudReadResult with_intensity = readCloud(write("scan.txt", "1 2 3 10 99 99\n4,5,6,20\n7;8;9;30\n"));
   EXPECT_EQ(with_intensity.cloud.intensity, (std::vector<float>{10, 20, 30}));
+}
+
+// A cloud another program wrote in millimetres reads as a scene kilometres across:
+// refused at the door with its unit named, whatever the format, rather than analysed.
+TEST_F(CloudIoTest, ACloudInMillimetresOrBeyondAnyScannersReachIsRefused) {
+  EXPECT_READ_ERROR(write("mm.xyz", "0 0 1000\n-500 0 12400\n-3600 0 1300\n"), "looks like millimetres",
+                    "write it in metres");
+  Cloud huge;
+  huge.points = {Vec3(0, 0, 1e30), Vec3(1e30, 0, 0)};
+  writeCloud(path("huge.ply"), huge);
+  EXPECT_READ_ERROR(path("huge.ply"), "reaches 1e+30 m from the origin");
 }
 
 TEST_F(CloudIoTest, CsvHeaderMapsColumnsByName) {

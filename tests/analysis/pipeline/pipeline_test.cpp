@@ -1217,6 +1217,18 @@ TEST(Pipeline, NonFiniteCoordinateIsRejected) {
   }
 }
 
+// A real main's scan scaled by 1e30, or written in millimetres, is refused before any
+// stage runs: analysed, it gave a 62-digit area and NaN angles.
+TEST(Pipeline, ACloudBeyondAnyScannersReachIsRefusedAndMillimetresAreNamed) {
+  ScanSimulation sim;
+  sim.points = 2000;
+  Cloud c = sampleSail(exampleDesign(SailType::Main), sim);
+  for (Vec3& p : c.points) p *= 1000.0;
+  expectThrowWith<InvalidInput>([&] { analyzeSail(c); }, {"[analyzeSail] the cloud looks like millimetres"});
+  for (Vec3& p : c.points) p *= 1e27;
+  expectThrowWith<InvalidInput>([&] { analyzeSail(c); }, {"e+31 m from the origin"});
+}
+
 TEST(Pipeline, PlanarWallIsNotMistakenForASail) {
   // A flat 4 m x 3 m wall with 4 mm noise: segmentation must refuse it.
   Cloud c;
