@@ -34,9 +34,11 @@ void useScannerBeam(OutlineParams& outline, ScannerModel model) {
   const ScannerSpec spec = scannerSpec(model);
   outline.beam_exit_diameter_m = spec.exit_diameter_m;
   outline.beam_divergence_rad = spec.beam_divergence_rad;
+  outline.scanner_max_range_m = spec.max_range_m;
 }
 
 bool useScannerBeamUnlessGiven(OutlineParams& outline, ScannerModel model, const Cloud& cloud) {
+  if (outline.scanner_max_range_m == 0) outline.scanner_max_range_m = scannerSpec(model).max_range_m;
   if (outline.beamGiven() || !cloud.viewpoint) return false;
   useScannerBeam(outline, model);
   return true;

@@ -33,11 +33,13 @@ ScannerSpec scannerSpec(ScannerModel model);
 
 struct OutlineParams;  // analysis/outline/sail_outline.hpp
 struct Cloud;          // analysis/core/cloud.hpp
-// The outline's beam settings for a cloud this model measured: its footprint
-// trims every edge (OutlineParams::beam_exit_diameter_m, beam_divergence_rad).
+// The outline's scanner settings for a cloud this model measured: its footprint
+// trims every edge (OutlineParams::beam_exit_diameter_m, beam_divergence_rad), and
+// beyond its range the scan stops (scanner_max_range_m).
 void useScannerBeam(OutlineParams& outline, ScannerModel model);
-// The same for `cloud`, unless the outline names a beam already or the cloud has
-// no viewpoint to place the footprint from. Whether it set the beam.
+// The same for `cloud`: the range unless one is set, the beam unless the outline
+// names one already or the cloud has no viewpoint to place the footprint from.
+// Whether it set the beam.
 bool useScannerBeamUnlessGiven(OutlineParams& outline, ScannerModel model, const Cloud& cloud);
 
 // A beam's footprint as the emulator casts it: ray 0 is the axis from `origin`

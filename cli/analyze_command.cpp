@@ -29,6 +29,7 @@ struct AnalyzeOptions {
   bool print_params = false, describe_params = false, no_segment = false, quiet = false, sky = false;
   int corners = -1;
   std::string scanner;  // lms111 / lms511: its beam footprint for the edges
+  std::vector<double> viewpoint;  // x, y, z of the scanner, m, for a cloud without one
 };
 
 void printTable(const SailAnalysis& a) {
@@ -50,6 +51,14 @@ void printTable(const SailAnalysis& a) {
   if (o.has_peak) std::printf(", top %.3f ± %.3f m", o.top_length_m, u.top_length_m);
   if (o.footprint_reach_m > 0)
     std::printf("\n  edges moved out by the beam's footprint, %.1f cm along luff and leech", 100 * o.footprint_reach_m);
+  const SailOutline::Coverage& cov = o.coverage;
+  if (cov.known) {
+    std::printf("\n  scanned to the sail's edge along %.0f %% of the luff, %.0f %% of the leech, %.0f %% of the foot",
+                100 * cov.luff, 100 * cov.leech, 100 * cov.foot);
+    if (o.has_peak) std::printf(", %.0f %% of the top", 100 * cov.top);
+  } else {
+    std::printf("\n  where the scan reached the sail's edges is not known: no scanner position (--viewpoint)");
+  }
   const LuffCurve& l = a.luff;
   std::printf("\n  luff curve: LUFA sag %.1f ± %.1f mm at %.0f ± %.0f %%, LUSW sag %.1f ± %.1f mm at %.0f ± %.0f %%\n\n",
               1000 * l.lufa_sag_m, 1000 * l.uncertainty.lufa_sag_m, l.lufa_position_pct, l.uncertainty.lufa_position_pct,
@@ -102,6 +111,7 @@ void run(const AnalyzeOptions& o) {
   ProgressBar bar(!o.quiet);
   CloudReadResult read = readCloud(o.input);
   for (const auto& w : read.warnings) std::fprintf(stderr, "warning: %s: %s\n", o.input.c_str(), w.c_str());
+  if (!o.viewpoint.empty()) read.cloud.viewpoint = Vec3(o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]);
   SailAnalysis a = analyzeSail(read.cloud, params, bar.progress());
   bar.finish();
   if (!o.mesh_out.empty()) writeMesh(o.mesh_out, a.mesh);
@@ -151,12 +161,20 @@ void addAnalyzeCommand(CLI::App& app) {
                   "reach (exit diameter/2 + range x divergence/2); the edges and corners are moved out by it. Needs "
                   "the scanner's position: the cloud's viewpoint (PLY/PCD header, as sailshape's scans write it). "
                   "Sets outline.beam_exit_diameter_m and beam_divergence_rad (see --print-params). In a wind tunnel "
-                  "(walls behind the sail); for a scan on the water see --sky")
+                  "(walls behind the sail); for a scan on the water see --sky. Its range (20 or 80 m, "
+                  "outline.scanner_max_range_m) tells a scan cut short by range from the sail's edge")
       ->check(CLI::IsMember({"lms111", "lms511"}, CLI::ignore_case));
   cmd->add_flag("--sky", opt->sky,
                 "Nothing but open sky lies behind the sail's edges (a scan on the water): a beam straddling an edge "
                 "returns from the sail alone while enough of it lies there, so the samples reach the edges and "
                 "--scanner's footprint moves nothing. Sets outline.edges_against_sky");
+  cmd->add_option("--viewpoint", opt->viewpoint,
+                  "Where the scanner stood, X,Y,Z in metres in the cloud's frame, for a cloud that does not carry it "
+                  "(a plain XYZ file; sailshape's own scans do): from it, a boundary the beams met at grazing "
+                  "incidence or at the end of their range is told apart from the sail's edge, and a corner the scan "
+                  "never reached is refused rather than placed where the samples stop. Overrides the file's")
+      ->expected(3)
+      ->delimiter(',');
   cmd->add_flag("--no-segment", opt->no_segment, "The input is the sail alone: skip segmentation");
   auto* print = cmd->add_flag("--print-params", opt->print_params,
                               "Print every pipeline parameter with its value as JSON (a --params file) and exit");

@@ -22,7 +22,8 @@ const std::vector<CommandExamples>& examples() {
   static const std::vector<CommandExamples> table = {
       {"", {"sailshape demo", "sailshape analyze assets/sample-main-scene.ply --sections 5"}},
       {"analyze",
-       {"sailshape analyze assets/sample-main-scene.ply --sections 5 --json main.json --mesh main-surface.ply",
+       {"sailshape analyze assets/sample-main-scene.ply --sections 5 --viewpoint -8,-9,5 --json main.json "
+        "--mesh main-surface.ply",
         "sailshape analyze --describe-params"}},
       {"simulate",
        {"sailshape simulate --type main --out main.ply --truth main-truth.json",

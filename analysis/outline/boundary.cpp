@@ -152,7 +152,8 @@ Vec3 BoundaryLoop::pointAt(double s) const {
 BoundaryLoop boundaryLoop(const Mesh& mesh) {
   BoundaryLoop loop;
   std::vector<Vec3>& pts = loop.points;
-  for (uint32_t v : outerBoundaryLoop(mesh)) pts.push_back(mesh.vertices[v]);
+  loop.vertex = outerBoundaryLoop(mesh);
+  for (uint32_t v : loop.vertex) pts.push_back(mesh.vertices[v]);
   const size_t n = pts.size();
   std::vector<double> seg(n);
   loop.cum.assign(n, 0.0);

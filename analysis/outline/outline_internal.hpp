@@ -34,6 +34,7 @@ std::vector<uint32_t> outerBoundaryLoop(const Mesh& mesh);
 // The outer boundary as a closed polyline, with what the other steps measure on it.
 struct BoundaryLoop {
   std::vector<Vec3> points;  // in loop order (closed: the last joins the first), m
+  std::vector<uint32_t> vertex;  // the mesh vertex of each point
   std::vector<double> cum;   // arc position of each point from the first, m
   double total = 0;          // the loop's length, m
   double spacing = 0;        // median segment length, m
@@ -222,5 +223,20 @@ Vec3 footprintShift(const OutlineParams& p, const Vec3& scanner, const Vec3& cor
 // the reach's uncertainty; returns the mean reach, m (0 for fewer than 3 points).
 double moveOutByFootprint(std::vector<Vec3>& line, double& sigma, const OutlineParams& p, const Vec3& scanner,
                           const Samples& samples);
+
+// ---- coverage.cpp: where the samples stop, and why ----
+
+// Whether the scan reached each corner and each edge (SailOutline::Coverage), from
+// where the scanner stood: a boundary the beams met at grazing incidence, or at the
+// end of their range, is where the scan stopped, not where the sail ends.
+SailOutline::Coverage scanCoverage(const BoundaryLoop& loop, const NamedCorners& corners, const Samples& samples,
+                                   const Vec3& scanner, const OutlineParams& params);
+
+// ---- consistency.cpp: whether the outline is a sail's ----
+
+// Throws AnalysisError in one line when the placed corners break the rules they were
+// named by (head highest, tack forward of the clew), an edge is as long as the others
+// together, or the head lies nearer the tack than the clew does.
+void refuseContradictoryOutline(const SailOutline& outline);
 
 }  // namespace sailshape::outline_internal

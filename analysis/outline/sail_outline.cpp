@@ -181,6 +181,12 @@ void checkOutlineParams(const OutlineParams& p) {
       p.beam_divergence_rad > 0.5)
     throw InvalidInput("[extractOutline] beam_exit_diameter_m must be in [0, 1] and beam_divergence_rad in [0, 0.5] (got " +
                        formatFixed(p.beam_exit_diameter_m, 4) + ", " + formatFixed(p.beam_divergence_rad, 4) + ")");
+  if (!(p.grazing_incidence_deg > 0 && p.grazing_incidence_deg <= 90))
+    throw InvalidInput("[extractOutline] grazing_incidence_deg must be in (0, 90] (got " +
+                       formatFixed(p.grazing_incidence_deg, 1) + ")");
+  if (!(p.scanner_max_range_m >= 0) || !std::isfinite(p.scanner_max_range_m))
+    throw InvalidInput("[extractOutline] scanner_max_range_m must be >= 0 (0: unknown; got " +
+                       formatFixed(p.scanner_max_range_m, 1) + ")");
   if (p.corners != 0 && p.corners != 3 && p.corners != 4)
     throw InvalidInput("[extractOutline] corners must be 0 (auto), 3 or 4 (got " + std::to_string(p.corners) + ")");
   if (!p.design_lengths_m.empty() && p.design_lengths_m.size() != 3)
@@ -215,6 +221,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   // Cells about three boundary spacings wide: the 24 nearest vertices of a boundary point lie within two or so.
   const PointGrid tree(mesh.vertices, 3.0 * std::max(sp, 1e-6));
   const Samples samples{mesh, normals, tree};
+  if (scanner) out.coverage = scanCoverage(loop, corners, samples, *scanner, p);
   const SailEdges edges = fitEdges(loop, corners, samples);
   setEdgeSigmas(edges, out);
 
@@ -229,6 +236,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   traceEdges(edges, p, footprint_scanner, samples, sp, out);
   out.area_m2 = mesh_area + areaBeyondMesh(loop, corners, out);
   setLengthAndAreaSigmas(spreads, out);
+  refuseContradictoryOutline(out);
   checkDesignLengths(p, out);
   return out;
 }

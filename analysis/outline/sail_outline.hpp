@@ -43,6 +43,13 @@ struct OutlineParams {
   // tunnel, where the walls lie behind, as they do in the built-in emulator's scene.
   bool edges_against_sky = false;
   bool beamGiven() const { return beam_exit_diameter_m != 0 || beam_divergence_rad != 0; }
+  // Where a scan stops without the sail ending (SPEC §3): beyond this incidence the
+  // cloth returns less and less and, at grazing angles, nothing; beyond the scanner's
+  // range nothing at all (0: the range is not known; a scanner model sets it). A
+  // boundary met at either, seen from the cloud's viewpoint, is where the scan
+  // stopped, and a corner there was not reached.
+  double grazing_incidence_deg = 70;
+  double scanner_max_range_m = 0;
 };
 
 struct SailOutline {
@@ -80,6 +87,19 @@ struct SailOutline {
   // mean reach, the larger; OutlineParams beam_*), m; 0 without that correction. A
   // section's curve may stop this much further from its ends than a sampled one.
   double footprint_reach_m = 0;
+  // What the scan covered, told from where the scanner stood (the cloud's viewpoint).
+  struct Coverage {
+    bool known = false;  // false: no viewpoint, so where the scan merely stopped cannot be told
+    // Each corner reached: the boundary beside it is where the sail ends, not where
+    // the beams grazed the cloth or ran out of range.
+    bool tack = true, clew = true, head = true, peak = true;
+    // The fraction of each edge's sampled boundary where the sail ends (the rest is
+    // where the scan stopped), in [0, 1].
+    double luff = 1, leech = 1, foot = 1, top = 1;
+    // Why a corner was not reached, one sentence per corner ("the head: ..."); empty when all were.
+    std::vector<std::string> unreached;
+    bool allCornersReached() const { return tack && clew && head && peak; }
+  } coverage;
   std::vector<std::string> warnings;
 };
 

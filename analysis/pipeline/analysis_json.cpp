@@ -71,6 +71,16 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
     sail_sigma["peak_m"] = ou.peak_m;
     sail_sigma["top_length_m"] = ou.top_length_m;
   }
+  // Where the samples stop because the sail ends, as a fraction of each edge's
+  // sampled boundary (the rest: grazing incidence or the end of the range); null
+  // without the scanner's position, when that cannot be told.
+  const SailOutline::Coverage& cov = o.coverage;
+  if (cov.known) {
+    j["sail"]["coverage"] = {{"luff", cov.luff}, {"leech", cov.leech}, {"foot", cov.foot}};
+    if (o.has_peak) j["sail"]["coverage"]["top"] = cov.top;
+  } else {
+    j["sail"]["coverage"] = nullptr;
+  }
   // How far the edges were moved out for the scanner's beam footprint (0: not).
   j["sail"]["beam_footprint_m"] = o.footprint_reach_m;
   // 1σ: a corner's as the distance it may lie off, the rest in their own units.

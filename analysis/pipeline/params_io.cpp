@@ -30,7 +30,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SurfaceParams, projection, max_e
                                                 largest_component_only)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(OutlineParams, corners, corner_window_m, min_fourth_corner_deg,
                                                 design_lengths_m, design_tolerance, design_warning,
-                                                beam_exit_diameter_m, beam_divergence_rad, edges_against_sky)
+                                                beam_exit_diameter_m, beam_divergence_rad, edges_against_sky,
+                                                grazing_incidence_deg, scanner_max_range_m)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions, plane, end_window, peak_window,
                                                 normal_tolerance_deg, max_tilt_deg, max_iterations, normal_radius,
                                                 noise_correlation_m, curve_points, max_bridged_gap)
@@ -229,6 +230,8 @@ const std::map<std::string, ParamNote>& paramNotes() {
       {"outline.beam_exit_diameter_m", {"m", "scanner beam's exit diameter, for the edges' footprint (0: none)"}},
       {"outline.beam_divergence_rad", {"rad", "scanner beam's full divergence, for the edges' footprint (0: none)"}},
       {"outline.edges_against_sky", {"-", "open sky behind the edges (a scan on the water): no footprint shift"}},
+      {"outline.grazing_incidence_deg", {"deg", "a boundary the beams meet beyond this incidence is where the scan stopped"}},
+      {"outline.scanner_max_range_m", {"m", "the scanner's range; a boundary there is where the scan stopped (0: unknown)"}},
       {"sections.count", {"-", "sections at t = k/(count+1) of luff and leech"}},
       {"sections.fractions", {"× luff", "explicit section heights in (0, 1); override count"}},
       {"sections.plane", {"-", "section plane: normal, perpendicular or horizontal"}},

@@ -453,11 +453,14 @@ void refuseImplausibleResults(const SailAnalysis& a) {
   if (auto why = implausibleArea(o.area_m2, "the area")) throw AnalysisError("[analyzeSail] " + *why);
   for (const Vec3& c : {o.tack, o.clew, o.head, o.peak})
     if (!c.allFinite()) throw AnalysisError("[analyzeSail] a corner's position is not a number");
+  // An end angle read from too few points is NaN, "not measured" (sections.hpp); the
+  // section's chord, camber, draft and twist are always numbers, and no value is infinite.
   for (const Section& s : a.sections.sections) {
     const SectionParameters& v = s.value;
-    for (double x : {v.chord_m, v.camber_pct, v.draft_pct, v.twist_deg, v.entry_deg, v.exit_deg})
-      if (!std::isfinite(x))
-        throw AnalysisError("[analyzeSail] section " + formatFixed(s.fraction, 2) + " has a value that is not a number");
+    const bool core_finite = std::isfinite(v.chord_m) && std::isfinite(v.camber_pct) && std::isfinite(v.draft_pct) &&
+                             std::isfinite(v.twist_deg);
+    if (!core_finite || std::isinf(v.entry_deg) || std::isinf(v.exit_deg))
+      throw AnalysisError("[analyzeSail] section " + formatFixed(s.fraction, 2) + " has a value that is not a number");
   }
 }
 

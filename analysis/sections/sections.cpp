@@ -815,6 +815,14 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
   if (outline.luff.size() < 2 || outline.leech.size() < 2)
     throw InvalidInput("[cutSections] outline has no luff or leech");
   const std::vector<double> fractions = sectionFractions(p);
+  // A section sits at a fraction of the luff and the leech from the tack and the clew
+  // up to the head (or peak): with a corner the scan never reached, those lengths, and
+  // where the fractions fall, are unknown.
+  if (!outline.coverage.allCornersReached()) {
+    std::string why;
+    for (const std::string& u : outline.coverage.unreached) why += (why.empty() ? "" : "; ") + u;
+    throw AnalysisError("[cutSections] no section can be placed, the scan did not reach every corner: " + why);
+  }
 
   // Plane of the corners: its normal starts every section plane.
   const Vec3 top = outline.has_peak ? 0.5 * (outline.head + outline.peak) : outline.head;

@@ -146,6 +146,122 @@ TEST(SailOutline, LengthsAreCheckedAgainstTheDesign) {
   }
 }
 
+// A flat triangle tack → clew → head in the x-z plane, triangulated on an n × n grid.
+Mesh flatTriangle(const Vec3& tack, const Vec3& clew, const Vec3& head, int n = 60) {
+  Mesh m;
+  std::map<std::pair<int, int>, uint32_t> id;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; i + j <= n; ++j) {
+      id[{i, j}] = static_cast<uint32_t>(m.vertices.size());
+      m.vertices.push_back(tack + (clew - tack) * i / n + (head - tack) * j / n);
+    }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; i + j < n; ++j) {
+      m.triangles.push_back({id[{i, j}], id[{i + 1, j}], id[{i, j + 1}]});
+      if (i + j + 1 < n) m.triangles.push_back({id[{i + 1, j}], id[{i + 1, j + 1}], id[{i, j + 1}]});
+    }
+  return m;
+}
+
+// The same outline code on a sail's triangle passes; on a low, wide patch (a hull's
+// side, a deck house), named by the same rules (the highest corner the head, the
+// forward low one the tack), the head lies nearer the tack than the clew does: no
+// sail is wider at its foot than it is tall, so the outline is refused in one line
+// instead of reporting a 3 m "luff" with a 6 m foot.
+TEST(SailOutline, APatchWiderThanItIsTallIsNoSail) {
+  const SailOutline sail = extractOutline(flatTriangle(Vec3(0, 0, 1), Vec3(-3.6, 0, 1.3), Vec3(-0.5, 0, 11)));
+  EXPECT_NEAR(sail.luff_length_m, std::hypot(0.5, 10.0), 0.05);
+  try {
+    extractOutline(flatTriangle(Vec3(0, 0, 0), Vec3(-6, 0, 0.2), Vec3(-1, 0, 3)));
+    FAIL() << "a patch 6 m wide and 3 m tall was taken for a sail";
+  } catch (const AnalysisError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("[extractOutline] the outline found is not a sail's: the head lies 3.", 0), 0u) << what;
+    EXPECT_NE(what.find("nearer than the clew (6."), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos);
+  }
+}
+
+// The triangles of `m` whose three vertices `keep` accepts (vertices left as they are).
+template <typename Keep>
+Mesh keepTriangles(const Mesh& m, Keep keep) {
+  Mesh out = m;
+  out.triangles.clear();
+  for (const auto& t : m.triangles)
+    if (keep(m.vertices[t[0]]) && keep(m.vertices[t[1]]) && keep(m.vertices[t[2]])) out.triangles.push_back(t);
+  return out;
+}
+
+// A flat main in the plane y = 0 seen from `scanner`: the beam's incidence on it, degrees.
+double incidenceDeg(const Vec3& scanner, const Vec3& p) {
+  const Vec3 ray = (p - scanner).normalized();
+  return std::acos(std::abs(ray.y())) * 180.0 / M_PI;
+}
+
+const Vec3 kTack(0, 0, 1), kClew(-3.6, 0, 1.3), kHead(-0.5, 0, 11);
+
+// Seen from 8 m to windward the whole main is met below 61° incidence: every edge
+// is where the sail ends, every corner reached.
+TEST(SailOutline, AMainSeenSquarelyIsCoveredToItsEdges) {
+  const Vec3 scanner(-1.5, -8, 5);
+  const SailOutline o = extractOutline(flatTriangle(kTack, kClew, kHead), {}, {}, 0, scanner);
+  ASSERT_TRUE(o.coverage.known);
+  EXPECT_TRUE(o.coverage.allCornersReached());
+  EXPECT_TRUE(o.coverage.unreached.empty());
+  EXPECT_DOUBLE_EQ(o.coverage.luff, 1.0);
+  EXPECT_DOUBLE_EQ(o.coverage.leech, 1.0);
+  EXPECT_DOUBLE_EQ(o.coverage.foot, 1.0);
+  // Without the scanner's position nothing can be told.
+  EXPECT_FALSE(extractOutline(flatTriangle(kTack, kClew, kHead)).coverage.known);
+}
+
+// From 1.5 m beside the plane the beams meet the main's upper part ever more
+// obliquely: as the sensor model does (SPEC §3), nothing returns beyond 75°. The
+// samples stop 5-6 m up across the sail, and that top boundary is where the scan
+// stopped, not a head: the head is not reached, and the foot's corners are.
+TEST(SailOutline, ATopCutOffByGrazingIncidenceLeavesTheHeadUnreached) {
+  const Vec3 scanner(-1.5, -1.5, 1.0);
+  const Mesh cut = keepTriangles(flatTriangle(kTack, kClew, kHead),
+                                 [&](const Vec3& p) { return incidenceDeg(scanner, p) < 75.0; });
+  const SailOutline o = extractOutline(cut, {}, {}, 0, scanner);
+  ASSERT_TRUE(o.coverage.known);
+  // The cut across the sail turns like a square top's: its two ends are taken for
+  // head and peak, and neither was reached.
+  ASSERT_TRUE(o.has_peak);
+  EXPECT_FALSE(o.coverage.head);
+  EXPECT_FALSE(o.coverage.peak);
+  EXPECT_TRUE(o.coverage.tack);
+  EXPECT_TRUE(o.coverage.clew);
+  ASSERT_EQ(o.coverage.unreached.size(), 2u);
+  EXPECT_EQ(o.coverage.unreached[0].rfind("the head: the samples stop where the beams meet the cloth at up to 7", 0), 0u)
+      << o.coverage.unreached[0];
+  EXPECT_EQ(o.coverage.unreached[1].rfind("the peak: the samples stop where the beams meet the cloth at up to 7", 0), 0u)
+      << o.coverage.unreached[1];
+  EXPECT_DOUBLE_EQ(o.coverage.foot, 1.0);
+}
+
+// A 20 m scanner (an LMS111) 17 m from the tack, below and to windward: the samples end
+// on the sphere of its range, about 5 m up. That boundary is the range's, and the head
+// is not reached.
+TEST(SailOutline, ATopBeyondTheScannersRangeLeavesTheHeadUnreached) {
+  const Vec3 scanner(-1.5, -12, -11);
+  OutlineParams p;
+  p.scanner_max_range_m = 20.0;
+  const Mesh cut = keepTriangles(flatTriangle(kTack, kClew, kHead),
+                                 [&](const Vec3& q) { return (q - scanner).norm() < p.scanner_max_range_m; });
+  const SailOutline o = extractOutline(cut, p, {}, 0, scanner);
+  ASSERT_TRUE(o.has_peak);  // the cut's two ends, as above
+  EXPECT_FALSE(o.coverage.head);
+  EXPECT_FALSE(o.coverage.peak);
+  EXPECT_TRUE(o.coverage.tack && o.coverage.clew);
+  ASSERT_EQ(o.coverage.unreached.size(), 2u);
+  for (const std::string& why : o.coverage.unreached)
+    EXPECT_NE(why.find("m from the scanner, at the end of its 20 m range"), std::string::npos) << why;
+  // Told no range, the same boundary is taken for the sail's edge: the range is what decides.
+  p.scanner_max_range_m = 0;
+  EXPECT_TRUE(extractOutline(cut, p, {}, 0, scanner).coverage.head);
+}
+
 TEST(SailOutline, AClosedSurfaceHasNoBoundary) {
   Mesh m;
   m.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
