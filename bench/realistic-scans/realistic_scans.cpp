@@ -26,17 +26,26 @@ struct Options {
   std::vector<uint64_t> seeds;  // given: these instead of fresh ones
   std::string table = "realistic-scans.md";
   std::string json_dir, ply_dir;
+  std::string sail, place;  // given: every configuration of this sail kind / at this unit place
   int threads = 2;
+  bool control = false;
 };
 
 void usage() {
   std::puts(
-      "realistic-scans [N] [--seed S]... [--table FILE] [--json DIR] [--ply DIR] [--threads T]\n"
+      "realistic-scans [N] [--seed S]... [--sail KIND] [--place PLACE] [--table FILE] [--json DIR] [--ply DIR]\n"
+      "                [--control] [--threads T]\n"
       "  N          configurations with fresh seeds (default 300)\n"
       "  --seed S   replay seed S instead (repeatable); N is then ignored\n"
+      "  --sail K   only sail kind K: pin-head-main, square-top-main, jib, genoa, asym-bow, asym-sprit,\n"
+      "             sym-spinnaker, code-zero (the rest still drawn from the seed)\n"
+      "  --place P  only unit place P: deck-leeward, deck-windward, stern-pulpit, mast-foot, bow, boom-end, tunnel\n"
       "  --table F  write the markdown table to F (default realistic-scans.md)\n"
       "  --json DIR write DIR/realistic_<seed>.json per configuration: config, truth, results, verdicts\n"
-      "  --ply DIR  write DIR/realistic_<seed>_own.ply (angles, viewpoint) and _xyz.ply (points only)\n"
+      "  --ply DIR  write DIR/realistic_<seed>_own.ply (angles, viewpoint), _xyz.ply (points only) and\n"
+      "             _sail.ply (the points on the sail alone, for analyze --no-segment)\n"
+      "  --control  also analyse each design sampled evenly (4 mm noise, the sail alone, as many points as the\n"
+      "             scan put on it): variant even-control, the analysis without the one-unit scan's effects\n"
       "  --threads  threads for each sweep's ray casting (default 2)\n"
       "Example: realistic-scans 40 --json /tmp/rs --table /tmp/rs/table.md");
 }
@@ -57,6 +66,12 @@ Options parse(int argc, char** argv) {
       std::exit(0);
     } else if (a == "--seed") {
       o.seeds.push_back(std::stoull(next()));
+    } else if (a == "--control") {
+      o.control = true;
+    } else if (a == "--sail") {
+      o.sail = next();
+    } else if (a == "--place") {
+      o.place = next();
     } else if (a == "--table") {
       o.table = next();
     } else if (a == "--json") {
@@ -128,6 +143,7 @@ int main(int argc, char** argv) {
   RunOptions ro;
   ro.threads = o.threads;
   ro.ply_dir = o.ply_dir;
+  ro.even_control = o.control;
   std::map<std::string, Tally> by_sail, by_place, by_variant;
   Tally all;
   std::vector<std::string> wrong;
@@ -135,7 +151,13 @@ int main(int argc, char** argv) {
   for (size_t i = 0; i < seeds.size(); ++i) {
     ConfigRun run;
     try {
-      run = runSeed(seeds[i], ro);
+      Config c = drawConfig(seeds[i]);
+      if (!o.sail.empty() || !o.place.empty()) {
+        const SailKind kind = o.sail.empty() ? c.sail : parseSailKind(o.sail);
+        const UnitPlace place = o.place.empty() ? c.place : parseUnitPlace(o.place);
+        c = drawConfig(seeds[i], kind, place);
+      }
+      run = runConfig(c, ro);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "seed %llu: %s\n", static_cast<unsigned long long>(seeds[i]), e.what());
       wrong.push_back("seed " + std::to_string(seeds[i]) + ": the harness failed: " + e.what());

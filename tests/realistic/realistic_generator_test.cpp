@@ -214,6 +214,7 @@ TEST(RealisticConfig, EachKindIsTheSailItNames) {
         case SailKind::SymSpinnaker:
           EXPECT_NEAR(full.design.leech_m / full.design.luff_m, 1.0, 0.031);
           EXPECT_LT(side * full.design.tack.y(), 0.0) << "tacked on the pole, to windward";
+          EXPECT_NEAR(surface.head().y(), 0.0, 1e-6) << "its head at the masthead";
           break;
         case SailKind::CodeZero:
           for (const ProfileStation& st : full.design.stations) EXPECT_LE(st.camber_pct, 8.0);

@@ -1,5 +1,6 @@
 #include "tests/support/realistic_judge.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -111,13 +112,15 @@ void judgeAnalysis(const SailAnalysis* a, const std::string& refusal, const Trut
 }
 
 VariantResult analyse(const std::string& name, const Cloud& cloud, const Truth& truth, const SailDesign& design,
-                      const Targets& tg) {
+                      const Targets& tg, bool segment = true) {
   VariantResult r;
   r.variant = name;
   const auto t0 = std::chrono::steady_clock::now();
   try {
     // As `sailshape analyze FILE` runs it: default parameters, the scene segmented first.
-    const SailAnalysis a = analyzeSail(cloud, AnalysisParams{});
+    AnalysisParams params;
+    params.segment = segment;
+    const SailAnalysis a = analyzeSail(cloud, params);
     r.seconds = seconds(t0);
     r.sail_points = a.sail_points;
     judgeAnalysis(&a, "", truth, design, tg, r);
@@ -142,7 +145,8 @@ json designJson(const SailDesign& d) {
   return {{"sail_type", sailTypeName(d.type)}, {"luff_m", d.luff_m},       {"leech_m", d.leech_m},
           {"foot_m", d.foot_m},                {"head_width_m", d.head_width_m}, {"tack", vec(d.tack)},
           {"rake_deg", d.rake_deg},            {"luff_round_m", d.luff_round_m}, {"luff_sag_m", d.luff_sag_m},
-          {"leech_round_m", d.leech_round_m},  {"leeward_port", d.leeward_port}, {"stations", stations}};
+          {"leech_round_m", d.leech_round_m},  {"lean_deg", d.lean_deg},       {"leeward_port", d.leeward_port},
+          {"stations", stations}};
 }
 
 }  // namespace
@@ -187,9 +191,24 @@ ConfigRun runConfig(const Config& config, const RunOptions& options) {
     const std::string stem = options.ply_dir + "/realistic_" + std::to_string(config.seed);
     writeCloud(stem + "_own.ply", scan.cloud, CloudFormat::PlyBinary);
     writeCloud(stem + "_xyz.ply", xyz, CloudFormat::PlyBinary);
+    // The sail's own points (their beams' axes hit it): the segmentation's right answer, to tell its
+    // failures from the outline's (`sailshape analyze --no-segment`).
+    std::vector<uint32_t> on_sail;
+    for (size_t i = 0; i < scan.object.size(); ++i)
+      if (scan.object[i] == static_cast<int>(scan.sail_object)) on_sail.push_back(static_cast<uint32_t>(i));
+    writeCloud(stem + "_sail.ply", selectPoints(scan.cloud, on_sail), CloudFormat::PlyBinary);
   }
   run.variants.push_back(analyse("own-scan", scan.cloud, run.truth, config.design, options.targets));
   run.variants.push_back(analyse("plain-xyz", xyz, run.truth, config.design, options.targets));
+  if (options.even_control) {
+    ScanSimulation sim;
+    sim.points = std::max<size_t>(run.sail_hits, 20000);
+    sim.noise_sigma_m = 0.004;
+    sim.seed = config.seed;
+    sim.viewpoint = config.unit.position;
+    run.variants.push_back(analyse("even-control", sampleSail(config.design, sim), run.truth, config.design,
+                                   options.targets, false));
+  }
   return run;
 }
 

@@ -39,7 +39,7 @@ struct JudgedValue {
 };
 
 struct VariantResult {
-  std::string variant;       // "own-scan" or "plain-xyz"
+  std::string variant;       // "own-scan", "plain-xyz" (or "even-control")
   bool refused = false;      // analyzeSail threw
   std::string refusal;       // its one line
   double seconds = 0;
@@ -60,8 +60,14 @@ struct ConfigRun {
 
 struct RunOptions {
   int threads = 1;            // for the sweep
-  std::string ply_dir;        // non-empty: write <dir>/realistic_<seed>_own.ply and _xyz.ply
+  // Non-empty: write <dir>/realistic_<seed>_own.ply (angles, RSSI, viewpoint), _xyz.ply (points only)
+  // and _sail.ply (the own scan's points on the sail alone).
+  std::string ply_dir;
   Targets targets;
+  // Also analyse the same design sampled evenly (sampleSail: as many points as the scan put on the
+  // sail, 4 mm noise along the rays, the sail alone): variant "even-control", what the analysis gives
+  // on these sails without the one-unit scan's density changes and gaps.
+  bool even_control = false;
 };
 
 // Draws the configuration from `seed`, sweeps it and judges both analyses.

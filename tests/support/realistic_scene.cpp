@@ -213,15 +213,16 @@ void rigSail(Config& c, double luff_target, Draw& draw) {
     }
     case SailKind::SymSpinnaker: {
       d.type = SailType::Gennaker;
-      // The pole from the mast to windward and forward; the generator's luff stands in the vertical
-      // plane through the tack, so the head sits above the pole's end, as far to windward.
+      // The pole from the mast to windward and forward, the tack on its end, the head at the masthead:
+      // the luff leans from the pole's end to the centreline (SailDesign::lean_deg).
       const double pole = 0.35 * loa * draw(0.85, 1.1), angle = draw(15.0, 35.0) * kDeg;
       b.pole = true;
       b.pole_end = Vec3(pole * std::cos(angle), -side * pole * std::sin(angle), b.deck_z_m + 0.12 * H);
-      const Vec3 head(0.03 * H, b.pole_end.y(), 0.95 * H);
-      const Vec3 luff = head - b.pole_end;
-      d.tack = b.pole_end + Vec3(0, 0, -b.boom_radius_m - 0.01 * H);
-      d.rake_deg = std::atan2(-luff.x(), luff.z()) / kDeg;
+      d.tack = b.pole_end + Vec3(0, 0, 0.6 * b.boom_radius_m + 0.005 * H);
+      const Vec3 head = masthead + Vec3(0.03 * H, 0, -0.04 * H);
+      const Vec3 luff = head - d.tack;
+      d.lean_deg = std::atan2(side * luff.y(), luff.z()) / kDeg;
+      d.rake_deg = std::asin(-luff.x() / luff.norm()) / kDeg;
       d.luff_m = luff.norm();
       d.leech_m = d.luff_m * draw(0.97, 1.03);
       d.foot_m = d.luff_m * draw(0.60, 0.75);
@@ -341,6 +342,24 @@ std::string unitPlaceName(UnitPlace place) {
     case UnitPlace::Tunnel: return "tunnel";
   }
   return "?";
+}
+
+SailKind parseSailKind(const std::string& name) {
+  std::string names;
+  for (SailKind k : kSailKinds) {
+    if (sailKindName(k) == name) return k;
+    names += (names.empty() ? "" : ", ") + sailKindName(k);
+  }
+  throw InvalidInput("[parseSailKind] unknown sail kind '" + name + "' (expected " + names + ")");
+}
+
+UnitPlace parseUnitPlace(const std::string& name) {
+  std::string names;
+  for (UnitPlace p : kUnitPlaces) {
+    if (unitPlaceName(p) == name) return p;
+    names += (names.empty() ? "" : ", ") + unitPlaceName(p);
+  }
+  throw InvalidInput("[parseUnitPlace] unknown unit place '" + name + "' (expected " + names + ")");
 }
 
 double Boat::halfBeamAt(double x) const {

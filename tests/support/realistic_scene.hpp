@@ -35,6 +35,9 @@ inline constexpr UnitPlace kUnitPlaces[] = {UnitPlace::DeckLeeward, UnitPlace::D
 
 std::string sailKindName(SailKind kind);     // "pin-head-main", "square-top-main", "jib", "genoa", "asym-bow", ...
 std::string unitPlaceName(UnitPlace place);  // "deck-leeward", "deck-windward", "stern-pulpit", "mast-foot", ...
+// The inverses; throw InvalidInput naming the names accepted.
+SailKind parseSailKind(const std::string& name);
+UnitPlace parseUnitPlace(const std::string& name);
 
 // The boat, every length scaled with the mast (deck at z = 0 unless in the tunnel).
 struct Boat {
