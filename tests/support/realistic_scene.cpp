@@ -425,7 +425,34 @@ Config drawConfig(uint64_t seed, SailKind sail, UnitPlace place) {
   c.unit.p_m = draw(0.02, 0.08);
   c.unit.theta_rad = draw(-kPi, kPi);
   c.unit.yaw_rad = draw(-kPi, kPi);
-  c.unit.position = unitPosition(c, draw);
+  // A unit stands clear of the sail: beyond the scanner's least range by 0.3 m from every point of it
+  // (a genoa sheeted to the rail covers the leeward deck under its foot; a unit there sees nothing).
+  const SailSurface surface(c.design);
+  const double clearance = spec.min_range_m + 0.3;
+  const auto nearestOf = [&](const Vec3& p) {
+    Vec3 best = surface.tack();
+    for (int i = 0; i <= 40; ++i)
+      for (int j = 0; j <= 20; ++j)
+        if ((surface.at(i / 40.0, j / 20.0) - p).norm() < (best - p).norm()) best = surface.at(i / 40.0, j / 20.0);
+    return best;
+  };
+  Vec3 best_place;
+  double best_gap = -1;
+  for (int attempt = 0; attempt < 10 && best_gap <= clearance; ++attempt) {
+    const Vec3 p = unitPosition(c, draw);
+    const double gap = (nearestOf(p) - p).norm();
+    if (gap > best_gap) best_gap = gap, best_place = p;
+  }
+  // Still under the sail (a small boat's boom or genoa foot over the leeward deck): step it sideways,
+  // away from the nearest cloth, until clear.
+  for (int step = 0; step < 40 && best_gap <= clearance; ++step) {
+    Vec3 away = best_place - nearestOf(best_place);
+    away.z() = 0;
+    if (away.norm() < 1e-6) away = Vec3(0, c.design.leeward_port ? 1 : -1, 0);
+    best_place += 0.1 * away.normalized();
+    best_gap = (nearestOf(best_place) - best_place).norm();
+  }
+  c.unit.position = best_place;
   aimSweep(c);
   c.sensor.model = c.unit.model;
   return c;
