@@ -49,6 +49,9 @@ JudgedValue corner(const std::string& name, const Vec3& measured, double sigma, 
   v.sigma = sigma;
   v.target = target;
   v.error = (measured - truth).norm();
+  v.is_corner = true;
+  v.measured_point = measured;
+  v.truth_point = truth;
   v.verdict = verdictFor(v.error, sigma, target);
   return v;
 }
@@ -227,6 +230,7 @@ std::string runToJson(const ConfigRun& run) {
     for (const JudgedValue& v : r.values) {
       json j = {{"name", v.name}, {"verdict", verdictName(v.verdict)}, {"target", v.target}};
       if (v.verdict == Verdict::Refused) j["reason"] = v.reason;
+      else if (v.is_corner) j.update({{"measured", vec(v.measured_point)}, {"sigma", v.sigma}, {"truth", vec(v.truth_point)}, {"error", v.error}});
       else j.update({{"measured", v.measured}, {"sigma", v.sigma}, {"truth", v.truth}, {"error", v.error}});
       values.push_back(j);
     }
@@ -271,11 +275,17 @@ std::vector<std::string> wrongValues(const ConfigRun& run) {
   for (const VariantResult& r : run.variants)
     for (const JudgedValue& v : r.values) {
       if (v.verdict != Verdict::Wrong) continue;
-      char buf[320];
-      std::snprintf(buf, sizeof buf, "seed %llu (%s at %s, %s): %s measured %.4g, truth %.4g, error %.4g, sigma %.3g",
+      char buf[400];
+      const Vec3 &m = v.measured_point, &t = v.truth_point;
+      char what[160];
+      if (v.is_corner)
+        std::snprintf(what, sizeof what, "at (%.3f, %.3f, %.3f), truth (%.3f, %.3f, %.3f)", m.x(), m.y(), m.z(), t.x(),
+                      t.y(), t.z());
+      else
+        std::snprintf(what, sizeof what, "measured %.4g, truth %.4g", v.measured, v.truth);
+      std::snprintf(buf, sizeof buf, "seed %llu (%s at %s, %s): %s %s, error %.4g, sigma %.3g",
                     static_cast<unsigned long long>(run.config.seed), sailKindName(run.config.sail).c_str(),
-                    unitPlaceName(run.config.place).c_str(), r.variant.c_str(), v.name.c_str(), v.measured, v.truth,
-                    v.error, v.sigma);
+                    unitPlaceName(run.config.place).c_str(), r.variant.c_str(), v.name.c_str(), what, v.error, v.sigma);
       out.push_back(buf);
     }
   return out;

@@ -33,6 +33,8 @@ struct JudgedValue {
   std::string name;          // "camber_pct@0.50", "tack_m", "luff_length_m", ...
   Verdict verdict = Verdict::Refused;
   double measured = 0, sigma = 0, truth = 0;  // for corners: measured = truth = 0, error = distance
+  bool is_corner = false;
+  Vec3 measured_point = Vec3::Zero(), truth_point = Vec3::Zero();  // a corner's, boat frame, m
   double error = 0;          // |measured − truth| (corner: distance), same units
   double target = 0;
   std::string reason;        // why refused / not measured
