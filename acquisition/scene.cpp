@@ -90,6 +90,7 @@ SailDesign sailFromJson(const json& j, const std::string& at) {
   d.luff_round_m = numberOr(j, "luff_round_m", d.luff_round_m, at);
   d.luff_sag_m = numberOr(j, "luff_sag_m", d.luff_sag_m, at);
   d.leech_round_m = numberOr(j, "leech_round_m", d.leech_round_m, at);
+  d.lean_deg = numberOr(j, "lean_deg", d.lean_deg, at);
   if (j.contains("leeward_port")) {
     if (!j.at("leeward_port").is_boolean()) throw InvalidInput(at + ": 'leeward_port' must be true or false");
     d.leeward_port = j.at("leeward_port").get<bool>();
@@ -293,7 +294,7 @@ Scene parseSceneJson(const std::string& text, const std::string& origin) {
       continue;
     } else if (type == "sail") {
       checkKeys(o, {"type", "name", "material", "sail_type", "scale", "luff_m", "leech_m", "foot_m", "head_width_m",
-                    "tack", "rake_deg", "luff_round_m", "luff_sag_m", "leech_round_m", "leeward_port", "stations",
+                    "tack", "rake_deg", "luff_round_m", "luff_sag_m", "leech_round_m", "lean_deg", "leeward_port", "stations",
                     "rows", "columns"},
                 at);
       const int rows = static_cast<int>(numberOr(o, "rows", 80, at));

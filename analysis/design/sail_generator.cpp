@@ -168,6 +168,8 @@ void validateDesign(const SailDesign& d) {
   positive(d.leech_m, "leech_m");
   positive(d.foot_m, "foot_m");
   if (d.type == SailType::SquareTopMain) positive(d.head_width_m, "head_width_m");
+  if (!(std::abs(d.lean_deg) < 60))
+    throw InvalidInput("[validateDesign] lean_deg must be within ±60 (got " + std::to_string(d.lean_deg) + ")");
   if (d.stations.empty()) throw InvalidInput("[validateDesign] at least one profile station is needed");
   for (size_t i = 0; i < d.stations.size(); ++i) {
     const ProfileStation& s = d.stations[i];
@@ -227,6 +229,13 @@ SailSurface::SailSurface(const SailDesign& design) : design_(design) {
     const double tw = pchip(station_f, station_twist, t) * kRad;
     const Eigen::AngleAxisd rot(-side * tw, Vec3::UnitZ());
     leech3[i] = luff3[i] + rot * (leech_flat - luff_flat[i]);
+  }
+  if (d.lean_deg != 0) {
+    const Eigen::AngleAxisd lean(-side * d.lean_deg * kRad, Vec3::UnitX());
+    for (int i = 0; i < kCurveSamples; ++i) {
+      luff3[i] = T + lean * (luff3[i] - T);
+      leech3[i] = T + lean * (leech3[i] - T);
+    }
   }
   luff_ = arcUniform(luff3, kCurveSamples);
   leech_ = arcUniform(leech3, kCurveSamples);

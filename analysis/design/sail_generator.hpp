@@ -44,6 +44,9 @@ struct SailDesign {
   double luff_sag_m = 0.0;     // luff sag to leeward at mid luff (gennakers)
   double leech_round_m = 0.0;  // roach, outwards at mid leech
   bool leeward_port = true;    // camber and twist towards +Y (starboard tack)
+  // The whole sail leaned about the boat's X axis through the tack, its head towards leeward by
+  // this angle: a symmetric spinnaker tacked to windward on its pole with its head at the masthead.
+  double lean_deg = 0.0;
   std::vector<ProfileStation> stations{{0.0, 9, 45, 8, 2, 2}, {0.5, 11, 45, 14, 2, 2}, {1.0, 8, 50, 22, 2, 2}};
 };
 
