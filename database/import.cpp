@@ -145,6 +145,11 @@ std::vector<Vec3> unpackCurve(const std::vector<uint8_t>& blob) {
   return curve;
 }
 
+namespace {
+void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
+                 const std::vector<uint8_t>* cloud_blob, const ImportHook& hook, ImportResult& result);
+}  // namespace
+
 ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
                         const ImportHook& hook) {
   if (meta.campaign.empty()) throw InvalidInput("[importScan] campaign name must not be empty");
@@ -166,9 +171,22 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
       throw InvalidInput("[importScan] control setting \"" + name + "\" needs a name and a finite value (got " +
                          std::to_string(value) + ")");
 
+  // Compressed before the transaction: it is the import's longest step, and the
+  // write lock (SQLite) or a retry (PostgreSQL) need not wait for it again.
+  const std::optional<std::vector<uint8_t>> cloud_blob =
+      cloud ? std::optional<std::vector<uint8_t>>(compressCloud(*cloud)) : std::nullopt;
   ImportResult result;
-  Transaction tx(db);
+  runTransaction(db, [&] {
+    result = ImportResult{};
+    writeImport(db, meta, analysis, cloud, cloud_blob ? &*cloud_blob : nullptr, hook, result);
+  });
+  return result;
+}
 
+namespace {
+
+void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
+                 const std::vector<uint8_t>* cloud_blob, const ImportHook& hook, ImportResult& result) {
   Statement c = db.prepare("SELECT id FROM campaigns WHERE name = ?");
   c.bind(1, meta.campaign);
   int64_t campaign_id;
@@ -198,8 +216,14 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
     boat_id = findOrCreate(db, "SELECT id FROM boats WHERE name = ?", "INSERT INTO boats(name) VALUES (?)", meta.boat);
   const int64_t sail_id =
       findOrCreate(db, "SELECT id FROM sails WHERE name = ?", "INSERT INTO sails(name) VALUES (?)", meta.sail);
-  if (!meta.sail_type.empty()) db.prepare("UPDATE sails SET type = ? WHERE id = ?").bind(1, meta.sail_type).bind(2, sail_id).run();
-  if (boat_id) db.prepare("UPDATE sails SET boat_id = ? WHERE id = ?").bind(1, *boat_id).bind(2, sail_id).run();
+  // Written only when it changes: concurrent importers of one sail then do not
+  // all write its row (on PostgreSQL each such write would abort the others).
+  if (!meta.sail_type.empty())
+    db.prepare("UPDATE sails SET type = ? WHERE id = ? AND (type IS NULL OR type <> ?)")
+        .bind(1, meta.sail_type).bind(2, sail_id).bind(3, meta.sail_type).run();
+  if (boat_id)
+    db.prepare("UPDATE sails SET boat_id = ? WHERE id = ? AND (boat_id IS NULL OR boat_id <> ?)")
+        .bind(1, *boat_id).bind(2, sail_id).bind(3, *boat_id).run();
 
   std::optional<int64_t> unit_id;
   if (!meta.scanner_unit.empty())
@@ -225,12 +249,14 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
     i.bind(6, meta.aws_m_s).bind(7, meta.drive_n).bind(8, meta.side_n).bind(9, meta.heel_moment_nm).run();
     result.trim_step_id = db.lastInsertId();
   }
-  Statement cs = db.prepare("INSERT OR REPLACE INTO control_settings(trim_step_id, name, value) VALUES (?, ?, ?)");
+  Statement cs = db.prepare("INSERT INTO control_settings(trim_step_id, name, value) VALUES (?, ?, ?)"
+                            " ON CONFLICT (trim_step_id, name) DO UPDATE SET value = excluded.value");
   for (const auto& [name, value] : meta.controls) {
     cs.bind(1, result.trim_step_id).bind(2, name).bind(3, value).run();
     cs.reset();
   }
-  Statement pr = db.prepare("INSERT OR REPLACE INTO pressures(trim_step_id, tap, pressure_pa) VALUES (?, ?, ?)");
+  Statement pr = db.prepare("INSERT INTO pressures(trim_step_id, tap, pressure_pa) VALUES (?, ?, ?)"
+                            " ON CONFLICT (trim_step_id, tap) DO UPDATE SET pressure_pa = excluded.pressure_pa");
   for (const auto& [tap, value] : meta.pressures_pa) {
     pr.bind(1, result.trim_step_id).bind(2, tap).bind(3, value).run();
     pr.reset();
@@ -249,7 +275,7 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
   if (meta.scanned_at.empty()) s.bindNull(3); else s.bind(3, meta.scanned_at);
   if (meta.settings.is_null()) s.bindNull(4); else s.bind(4, meta.settings.dump());
   if (meta.raw_capture.empty()) s.bindNull(5); else s.bind(5, meta.raw_capture);
-  if (cloud) s.bindBlob(6, compressCloud(*cloud)); else s.bindNull(6);
+  if (cloud_blob) s.bindBlob(6, *cloud_blob); else s.bindNull(6);
   s.bind(7, static_cast<int64_t>(point_count)).run();
   result.scan_id = db.lastInsertId();
   if (hook) hook("scan");
@@ -259,9 +285,9 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
         writeAnalysis(db, result.scan_id, *analysis, meta.software_version, "importScan", &result.sections, hook);
     if (hook) hook("sections");
   }
-  tx.commit();
-  return result;
 }
+
+}  // namespace
 
 int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis, const std::string& software_version) {
   if (!hasSectionsArray(analysis))
@@ -269,12 +295,13 @@ int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysi
   if (analysis.contains("diagnostics") && !analysis["diagnostics"].is_object())
     throw InvalidInput("[addAnalysis] the analysis document's diagnostics must be an object (got " +
                        std::string(analysis["diagnostics"].type_name()) + ")");
-  Transaction tx(db);
-  Statement s = db.prepare("SELECT 1 FROM scans WHERE id = ?");
-  s.bind(1, scan_id);
-  if (!s.step()) throw InvalidInput("[addAnalysis] no scan with id " + std::to_string(scan_id));
-  const int64_t id = writeAnalysis(db, scan_id, analysis, software_version, "addAnalysis", nullptr, {});
-  tx.commit();
+  int64_t id = 0;
+  runTransaction(db, [&] {
+    Statement s = db.prepare("SELECT 1 FROM scans WHERE id = ?");
+    s.bind(1, scan_id);
+    if (!s.step()) throw InvalidInput("[addAnalysis] no scan with id " + std::to_string(scan_id));
+    id = writeAnalysis(db, scan_id, analysis, software_version, "addAnalysis", nullptr, {});
+  });
   return id;
 }
 
