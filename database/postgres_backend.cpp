@@ -46,6 +46,12 @@ bool connectionClass(const std::string& sqlstate) {
                          oneLine(e.what()) + ")");
   } catch (const pqxx::broken_connection& e) {
     throw ConnectionLost(where + lost + oneLine(e.what()) + ")");
+  } catch (const pqxx::statement_completion_unknown& e) {
+    throw DatabaseError(where + oneLine(e.what()) + " (SQLSTATE 40003)");
+  } catch (const pqxx::transaction_rollback& e) {
+    // libpqxx 6 gives 40001 (serialization failure) and 40P01 (deadlock) these
+    // classes, outside sql_error.
+    throw SerializationFailure(where + "transaction aborted by a concurrent writer (" + oneLine(e.what()) + ")");
   } catch (const pqxx::sql_error& e) {
     const std::string state = e.sqlstate();
     const std::string msg = oneLine(e.what());

@@ -11,7 +11,10 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <signal.h>
+
 #include <atomic>
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -29,10 +32,12 @@ class PgCluster {
   // Throws std::runtime_error (one line) when no cluster can be started.
   PgCluster() {
     bin_ = findBin();
+    as_root_ = geteuid() == 0;
+    stopOrphans();
     std::string pattern = (std::filesystem::temp_directory_path() / "sailshape-pg-XXXXXX").string();
     if (!mkdtemp(pattern.data())) throw std::runtime_error("PostgreSQL test cluster: mkdtemp failed");
     dir_ = pattern;
-    as_root_ = geteuid() == 0;
+    std::ofstream(dir_ + "/owner") << getpid();
     if (as_root_) {
       const passwd* pw = getpwnam("postgres");
       if (!pw) throw std::runtime_error("PostgreSQL test cluster: no `postgres` user to run it as (run scripts/setup)");
@@ -105,6 +110,24 @@ class PgCluster {
       throw std::runtime_error(
           "PostgreSQL tests need a server: no initdb under /usr/lib/postgresql/*/bin (run scripts/setup)");
     return best;
+  }
+
+  // Clusters whose test process died without stopping them (killed by a
+  // timeout, say): stopped and removed.
+  void stopOrphans() const {
+    glob_t g{};
+    const std::string pattern = (std::filesystem::temp_directory_path() / "sailshape-pg-*").string();
+    if (glob(pattern.c_str(), 0, nullptr, &g) == 0)
+      for (size_t i = 0; i < g.gl_pathc; ++i) {
+        const std::string dir = g.gl_pathv[i];
+        pid_t owner = 0;
+        std::ifstream(dir + "/owner") >> owner;
+        if (owner <= 0 || kill(owner, 0) == 0 || errno != ESRCH) continue;
+        (void)std::system(wrap(bin_ + "/pg_ctl -D " + dir + "/data -m immediate -w stop > /dev/null 2>&1").c_str());
+        std::error_code ec;
+        std::filesystem::remove_all(dir, ec);
+      }
+    globfree(&g);
   }
 
   static int freePort() {

@@ -18,7 +18,8 @@ namespace {
 
 using test::analysisDoc;
 using test::scalar;
-using test::StoreTest;
+
+class Store : public test::StoreTest {};
 
 // The Queries fixture's data set (queries_test.cpp): Gen-A (genoa, boat Alpha,
 // campaign Lorient) test t1 steps 0..3 at AWA 80/90/95/100, drive
@@ -91,7 +92,7 @@ size_t column(const Table& t, const std::string& name) {
   return 0;
 }
 
-TEST_P(StoreTest, NewStoreIsAtTheCurrentVersionAndChecksClean) {
+TEST_P(Store, NewStoreIsAtTheCurrentVersionAndChecksClean) {
   Database db = openSailDatabase(location_);
   EXPECT_EQ(db.backend(), GetParam());
   EXPECT_EQ(db.userVersion(), kSchemaVersion);
@@ -102,7 +103,7 @@ TEST_P(StoreTest, NewStoreIsAtTheCurrentVersionAndChecksClean) {
   EXPECT_EQ(again.userVersion(), kSchemaVersion);
 }
 
-TEST_P(StoreTest, MigratesFromEveryOlderVersionKeepingData) {
+TEST_P(Store, MigratesFromEveryOlderVersionKeepingData) {
   for (int from = 0; from < kSchemaVersion; ++from) {
     const std::string location = newLocation();
     {
@@ -119,7 +120,7 @@ TEST_P(StoreTest, MigratesFromEveryOlderVersionKeepingData) {
   }
 }
 
-TEST_P(StoreTest, NewerSchemaAndForeignTablesAreRefusedAndLeftAsTheyWere) {
+TEST_P(Store, NewerSchemaAndForeignTablesAreRefusedAndLeftAsTheyWere) {
   {
     Database raw(location_);
     raw.exec("CREATE TABLE orders (id INTEGER NOT NULL, item TEXT)");
@@ -144,7 +145,7 @@ TEST_P(StoreTest, NewerSchemaAndForeignTablesAreRefusedAndLeftAsTheyWere) {
   EXPECT_EQ(Database(newer).userVersion(), kSchemaVersion + 1);
 }
 
-TEST_P(StoreTest, ImportStoresScanAnalysisAndCloudAndReadsThemBack) {
+TEST_P(Store, ImportStoresScanAnalysisAndCloudAndReadsThemBack) {
   Database db = openSailDatabase(location_);
   fill(db);
   EXPECT_EQ(scalar(db, "SELECT count(*) FROM scans"), 6);
@@ -168,7 +169,7 @@ TEST_P(StoreTest, ImportStoresScanAnalysisAndCloudAndReadsThemBack) {
   EXPECT_TRUE(db.integrityCheck().empty());
 }
 
-TEST_P(StoreTest, AFailedImportStoresNothing) {
+TEST_P(Store, AFailedImportStoresNothing) {
   Database db = openSailDatabase(location_);
   ImportMetadata m;
   m.campaign = "Lorient";
@@ -191,7 +192,7 @@ TEST_P(StoreTest, AFailedImportStoresNothing) {
   EXPECT_EQ(scalar(db, "SELECT count(*) FROM sections"), 3);
 }
 
-TEST_P(StoreTest, QueriesAnswerTheKnownValues) {
+TEST_P(Store, QueriesAnswerTheKnownValues) {
   Database db = openSailDatabase(location_);
   fill(db);
   EXPECT_EQ(findScans(db).rows.size(), 6u);
@@ -224,7 +225,7 @@ TEST_P(StoreTest, QueriesAnswerTheKnownValues) {
   EXPECT_THROW(parameterEvolution(db, "t1", "camber", 0.5), InvalidInput);
 }
 
-TEST_P(StoreTest, CopiesIntoAnEmptyStoreOfEitherBackendAndBack) {
+TEST_P(Store, CopiesIntoAnEmptyStoreOfEitherBackendAndBack) {
   Database source = openSailDatabase(location_);
   fill(source);
   const std::string expected = allAnswers(source);
@@ -265,7 +266,7 @@ TEST_P(StoreTest, CopiesIntoAnEmptyStoreOfEitherBackendAndBack) {
   EXPECT_TRUE(back.integrityCheck().empty());
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, StoreTest, ::testing::Values(Backend::SQLite, Backend::PostgreSQL), test::backendName);
+INSTANTIATE_TEST_SUITE_P(Backends, Store, ::testing::Values(Backend::SQLite, Backend::PostgreSQL), test::backendName);
 
 // The same imports answer every query identically, byte for byte, on both.
 TEST(BothBackends, AnswerEveryQueryAlike) {
