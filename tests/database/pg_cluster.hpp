@@ -2,8 +2,10 @@
 // A private PostgreSQL cluster for the tests: initdb and pg_ctl (as the
 // `postgres` user when run as root, since PostgreSQL refuses root) in a
 // temporary folder, listening on 127.0.0.1 only on a free port, stopped and
-// removed when the test process ends. One per test process, started on first
-// use; each test takes a fresh database in it.
+// removed at the end; each test takes a fresh database in it. Under ctest one
+// cluster serves the whole run (the pg_test_cluster fixture starts it in
+// SAILSHAPE_TEST_PG_DIR and stops it after the last test); a test binary run
+// by hand starts its own on first use and stops it when it exits.
 #include <arpa/inet.h>
 #include <glob.h>
 #include <netinet/in.h>
@@ -19,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,15 +32,23 @@ namespace sailshape::test {
 
 class PgCluster {
  public:
-  // Throws std::runtime_error (one line) when no cluster can be started.
-  PgCluster() {
+  // Starts a cluster in a new temporary folder, or in `dir` (created; then it
+  // is left running, its port and programs written there for attach() and
+  // stop()). Throws std::runtime_error (one line) when none can be started.
+  explicit PgCluster(const std::string& dir = "") {
     bin_ = findBin();
     as_root_ = geteuid() == 0;
-    stopOrphans();
-    std::string pattern = (std::filesystem::temp_directory_path() / "sailshape-pg-XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw std::runtime_error("PostgreSQL test cluster: mkdtemp failed");
-    dir_ = pattern;
-    std::ofstream(dir_ + "/owner") << getpid();
+    if (dir.empty()) {
+      stopOrphans();
+      std::string pattern = (std::filesystem::temp_directory_path() / "sailshape-pg-XXXXXX").string();
+      if (!mkdtemp(pattern.data())) throw std::runtime_error("PostgreSQL test cluster: mkdtemp failed");
+      dir_ = pattern;
+      std::ofstream(dir_ + "/owner") << getpid();
+    } else {
+      dir_ = dir;
+      std::filesystem::create_directories(dir_);
+      owned_ = false;
+    }
     if (as_root_) {
       const passwd* pw = getpwnam("postgres");
       if (!pw) throw std::runtime_error("PostgreSQL test cluster: no `postgres` user to run it as (run scripts/setup)");
@@ -52,16 +63,32 @@ class PgCluster {
     // power cut is PostgreSQL's, not ours to test.
     run(bin_ + "/pg_ctl -D " + data + " -l " + log + " -w -t 60 -o \"-p " + std::to_string(port_) +
             " -c listen_addresses=127.0.0.1 -c unix_socket_directories=" + dir_ +
-            " -c fsync=off -c synchronous_commit=off -c full_page_writes=off -c max_connections=60\" start > " + dir_ +
+            " -c fsync=off -c synchronous_commit=off -c full_page_writes=off -c max_connections=200\" start > " + dir_ +
             "/pg_ctl.log 2>&1",
         "pg_ctl start", log);
     started_ = true;
+    std::ofstream(dir_ + "/bin") << bin_;
+    std::ofstream(dir_ + "/port") << port_;
   }
   ~PgCluster() {
-    if (started_)
-      (void)std::system(wrap(bin_ + "/pg_ctl -D " + dir_ + "/data -m immediate -w stop > /dev/null 2>&1").c_str());
+    if (!owned_) return;
+    if (started_) stop(dir_, bin_, as_root_);
     std::error_code ec;
     std::filesystem::remove_all(dir_, ec);
+  }
+
+  // The cluster a PgCluster(dir) left running.
+  static std::unique_ptr<PgCluster> attach(const std::string& dir) {
+    std::unique_ptr<PgCluster> c(new PgCluster(Attached{}));
+    c->dir_ = dir;
+    std::ifstream(dir + "/bin") >> c->bin_;
+    std::ifstream(dir + "/port") >> c->port_;
+    if (c->port_ <= 0) throw std::runtime_error("PostgreSQL test cluster: " + dir + " holds no running cluster");
+    return c;
+  }
+  static void stop(const std::string& dir, const std::string& bin, bool as_root) {
+    const std::string command = bin + "/pg_ctl -D " + dir + "/data -m immediate -w stop > /dev/null 2>&1";
+    (void)std::system((as_root ? "runuser -u postgres -- sh -c '" + command + "'" : command).c_str());
   }
   PgCluster(const PgCluster&) = delete;
   PgCluster& operator=(const PgCluster&) = delete;
@@ -73,19 +100,28 @@ class PgCluster {
   // A new, empty database; returns its URL.
   std::string createDatabase() {
     static std::atomic<int> counter{0};
-    const std::string name = "sailshape_" + std::to_string(getpid()) + "_" + std::to_string(++counter);
+    static const unsigned salt = std::random_device{}();  // a pid can come again within one ctest run
+    const std::string name = "sailshape_" + std::to_string(getpid()) + "_" + std::to_string(salt % 100000) + "_" +
+                             std::to_string(++counter);
     Database admin(url("postgres"));
     admin.exec("CREATE DATABASE " + name);
     return url(name);
   }
 
-  // The cluster of this test process.
+  // The cluster of this test process: ctest's (SAILSHAPE_TEST_PG_DIR) or its own.
   static PgCluster& shared() {
     static std::unique_ptr<PgCluster> cluster;
     static std::string failure;
     if (!cluster && failure.empty()) {
       try {
-        cluster = std::make_unique<PgCluster>();
+        const char* dir = std::getenv("SAILSHAPE_TEST_PG_DIR");
+        if (dir && *dir) {
+          std::ifstream error(std::string(dir) + "/error");
+          if (error && std::getline(error, failure)) throw std::runtime_error(failure);
+          cluster = attach(dir);
+        } else {
+          cluster = std::make_unique<PgCluster>();
+        }
       } catch (const std::exception& e) {
         failure = e.what();
       }
@@ -95,6 +131,9 @@ class PgCluster {
   }
 
  private:
+  struct Attached {};
+  explicit PgCluster(Attached) : owned_(false) {}
+
   static std::string findBin() {
     glob_t g{};
     std::string best;
@@ -123,7 +162,7 @@ class PgCluster {
         pid_t owner = 0;
         std::ifstream(dir + "/owner") >> owner;
         if (owner <= 0 || kill(owner, 0) == 0 || errno != ESRCH) continue;
-        (void)std::system(wrap(bin_ + "/pg_ctl -D " + dir + "/data -m immediate -w stop > /dev/null 2>&1").c_str());
+        stop(dir, bin_, as_root_);
         std::error_code ec;
         std::filesystem::remove_all(dir, ec);
       }
@@ -164,6 +203,7 @@ class PgCluster {
   int port_ = 0;
   bool as_root_ = false;
   bool started_ = false;
+  bool owned_ = true;  // stopped and removed by the destructor
 };
 
 }  // namespace sailshape::test
