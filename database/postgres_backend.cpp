@@ -129,9 +129,10 @@ class PgStatement : public StatementBackend {
   PgConnection* db_;
   std::string sql_;
   std::vector<std::optional<std::string>> params_;
-  pqxx::result result_;
-  bool executed_ = false;
-  long row_ = -1;
+  // The result, fetched whole at the first step() (or columnCount()).
+  mutable pqxx::result result_;
+  mutable bool executed_ = false;
+  mutable long row_ = -1;
 };
 
 class PgConnection : public ConnectionBackend {
@@ -291,10 +292,9 @@ bool PgStatement::step() {
 int PgStatement::columnCount() const {
   if (!executed_) {
     // SQLite knows a statement's columns before it runs; callers ask first.
-    auto* self = const_cast<PgStatement*>(this);
-    self->result_ = db_->run(sql_, params_, "Statement::columnCount");
-    self->executed_ = true;
-    self->row_ = -1;
+    result_ = db_->run(sql_, params_, "Statement::columnCount");
+    executed_ = true;
+    row_ = -1;
   }
   return static_cast<int>(result_.columns());
 }
