@@ -240,9 +240,19 @@ TEST_P(Store, CopiesIntoAnEmptyStoreOfEitherBackendAndBack) {
   EXPECT_EQ(r.total_rows, 2u + 1 + 3 + 1 + 2 + 6 + 8 + 4 + 6 + 6 + 18);
   EXPECT_EQ(allAnswers(there), expected);
   EXPECT_TRUE(there.integrityCheck().empty());
+  // The compressed cloud arrives byte for byte, so a re-analysis from either store is the same.
+  auto cloudBlob = [](Database& db) {
+    Statement s = db.prepare("SELECT cloud FROM scans WHERE cloud IS NOT NULL");
+    EXPECT_TRUE(s.step());
+    return s.columnBlob(0);
+  };
+  const std::vector<uint8_t> blob = cloudBlob(source);
+  EXPECT_GT(blob.size(), 1000u);
+  EXPECT_EQ(cloudBlob(there), blob);
   Database back = openSailDatabase(newLocation());
   copyStore(there, back);
   EXPECT_EQ(allAnswers(back), expected);
+  EXPECT_EQ(cloudBlob(back), blob);
   EXPECT_EQ(loadScanRecord(back, 6).cloud->size(), 2000u);
   // New rows after a copy take ids after the copied ones.
   ImportMetadata m;
