@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <random>
+#include <thread>
 
 #include "analysis/core/errors.hpp"
 #include "database/import.hpp"
@@ -158,6 +159,28 @@ TEST_P(StoreConcurrency, ReadersKeepReadingWhileAWriterWrites) {
   });
   EXPECT_EQ(seen_during, 1u);
   EXPECT_EQ(findScans(reader).rows.size(), 2u);
+}
+
+TEST_P(StoreConcurrency, StoresOpenedFirstByManyAtOnceAreMigratedOnce) {
+  constexpr int kOpeners = 6;  // threads, each with its own connection
+  std::vector<std::thread> threads;
+  std::vector<std::string> errors(kOpeners);
+  for (int i = 0; i < kOpeners; ++i)
+    threads.emplace_back([&, i] {
+      try {
+        OpenOptions o;
+        o.busy_timeout_ms = 30000;
+        Database db = openSailDatabase(location_, o);
+        if (db.userVersion() != kSchemaVersion) errors[i] = "version " + std::to_string(db.userVersion());
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
+    });
+  for (auto& t : threads) t.join();
+  for (int i = 0; i < kOpeners; ++i) EXPECT_EQ(errors[i], "") << "opener " << i;
+  Database db = openSailDatabase(location_);
+  EXPECT_EQ(db.tableCount(), 14);
+  EXPECT_TRUE(db.integrityCheck().empty());
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, StoreConcurrency, ::testing::Values(Backend::SQLite, Backend::PostgreSQL), test::backendName);
