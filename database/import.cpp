@@ -125,66 +125,7 @@ int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, 
   return analysis_id;
 }
 
-bool hasSectionsArray(const nlohmann::json& doc) {
-  return doc.is_object() && doc.contains("sections") && doc["sections"].is_array();
-}
-
-}  // namespace
-
-std::vector<uint8_t> packCurve(const std::vector<Vec3>& curve) {
-  std::vector<uint8_t> out(curve.size() * 24);
-  for (size_t i = 0; i < curve.size(); ++i) std::memcpy(out.data() + 24 * i, curve[i].data(), 24);
-  return out;
-}
-
-std::vector<Vec3> unpackCurve(const std::vector<uint8_t>& blob) {
-  if (blob.size() % 24 != 0)
-    throw DatabaseError("[unpackCurve] curve blob of " + std::to_string(blob.size()) + " bytes is not N×3 float64");
-  std::vector<Vec3> curve(blob.size() / 24);
-  for (size_t i = 0; i < curve.size(); ++i) std::memcpy(curve[i].data(), blob.data() + 24 * i, 24);
-  return curve;
-}
-
-namespace {
-void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
-                 const std::vector<uint8_t>* cloud_blob, const ImportHook& hook, ImportResult& result);
-}  // namespace
-
-ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
-                        const ImportHook& hook) {
-  if (meta.campaign.empty()) throw InvalidInput("[importScan] campaign name must not be empty");
-  if (meta.sail.empty()) throw InvalidInput("[importScan] sail name must not be empty");
-  if (meta.campaign_kind != "full_scale" && meta.campaign_kind != "wind_tunnel")
-    throw InvalidInput("[importScan] campaign_kind must be full_scale or wind_tunnel (got \"" + meta.campaign_kind + "\")");
-  requireFinite(meta.awa_deg, "awa_deg");
-  requireFinite(meta.aws_m_s, "aws_m_s");
-  if (meta.awa_deg && (*meta.awa_deg < -180 || *meta.awa_deg > 360))
-    throw InvalidInput("[importScan] awa_deg must be in [-180, 360] (got " + std::to_string(*meta.awa_deg) + ")");
-  if (!analysis && !cloud) throw InvalidInput("[importScan] nothing to import: neither an analysis nor a cloud");
-  if (analysis && !hasSectionsArray(*analysis))
-    throw InvalidInput("[importScan] the analysis document has no \"sections\" array (is it `sailshape analyze --json` output?)");
-  if (analysis && analysis->contains("diagnostics") && !(*analysis)["diagnostics"].is_object())
-    throw InvalidInput("[importScan] the analysis document's diagnostics must be an object (got " +
-                       std::string((*analysis)["diagnostics"].type_name()) + ")");
-  for (const auto& [name, value] : meta.controls)
-    if (name.empty() || !std::isfinite(value))
-      throw InvalidInput("[importScan] control setting \"" + name + "\" needs a name and a finite value (got " +
-                         std::to_string(value) + ")");
-
-  // Compressed before the transaction: it is the import's longest step, and the
-  // write lock (SQLite) or a retry (PostgreSQL) need not wait for it again.
-  const std::optional<std::vector<uint8_t>> cloud_blob =
-      cloud ? std::optional<std::vector<uint8_t>>(compressCloud(*cloud)) : std::nullopt;
-  ImportResult result;
-  runTransaction(db, [&] {
-    result = ImportResult{};
-    writeImport(db, meta, analysis, cloud, cloud_blob ? &*cloud_blob : nullptr, hook, result);
-  });
-  return result;
-}
-
-namespace {
-
+// Every row of one import; the caller holds the transaction.
 void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
                  const std::vector<uint8_t>* cloud_blob, const ImportHook& hook, ImportResult& result) {
   Statement c = db.prepare("SELECT id FROM campaigns WHERE name = ?");
@@ -287,7 +228,61 @@ void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json*
   }
 }
 
+
+bool hasSectionsArray(const nlohmann::json& doc) {
+  return doc.is_object() && doc.contains("sections") && doc["sections"].is_array();
+}
+
 }  // namespace
+
+std::vector<uint8_t> packCurve(const std::vector<Vec3>& curve) {
+  std::vector<uint8_t> out(curve.size() * 24);
+  for (size_t i = 0; i < curve.size(); ++i) std::memcpy(out.data() + 24 * i, curve[i].data(), 24);
+  return out;
+}
+
+std::vector<Vec3> unpackCurve(const std::vector<uint8_t>& blob) {
+  if (blob.size() % 24 != 0)
+    throw DatabaseError("[unpackCurve] curve blob of " + std::to_string(blob.size()) + " bytes is not N×3 float64");
+  std::vector<Vec3> curve(blob.size() / 24);
+  for (size_t i = 0; i < curve.size(); ++i) std::memcpy(curve[i].data(), blob.data() + 24 * i, 24);
+  return curve;
+}
+
+
+ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
+                        const ImportHook& hook) {
+  if (meta.campaign.empty()) throw InvalidInput("[importScan] campaign name must not be empty");
+  if (meta.sail.empty()) throw InvalidInput("[importScan] sail name must not be empty");
+  if (meta.campaign_kind != "full_scale" && meta.campaign_kind != "wind_tunnel")
+    throw InvalidInput("[importScan] campaign_kind must be full_scale or wind_tunnel (got \"" + meta.campaign_kind + "\")");
+  requireFinite(meta.awa_deg, "awa_deg");
+  requireFinite(meta.aws_m_s, "aws_m_s");
+  if (meta.awa_deg && (*meta.awa_deg < -180 || *meta.awa_deg > 360))
+    throw InvalidInput("[importScan] awa_deg must be in [-180, 360] (got " + std::to_string(*meta.awa_deg) + ")");
+  if (!analysis && !cloud) throw InvalidInput("[importScan] nothing to import: neither an analysis nor a cloud");
+  if (analysis && !hasSectionsArray(*analysis))
+    throw InvalidInput("[importScan] the analysis document has no \"sections\" array (is it `sailshape analyze --json` output?)");
+  if (analysis && analysis->contains("diagnostics") && !(*analysis)["diagnostics"].is_object())
+    throw InvalidInput("[importScan] the analysis document's diagnostics must be an object (got " +
+                       std::string((*analysis)["diagnostics"].type_name()) + ")");
+  for (const auto& [name, value] : meta.controls)
+    if (name.empty() || !std::isfinite(value))
+      throw InvalidInput("[importScan] control setting \"" + name + "\" needs a name and a finite value (got " +
+                         std::to_string(value) + ")");
+
+  // Compressed before the transaction: it is the import's longest step, and the
+  // write lock (SQLite) or a retry (PostgreSQL) need not wait for it again.
+  const std::optional<std::vector<uint8_t>> cloud_blob =
+      cloud ? std::optional<std::vector<uint8_t>>(compressCloud(*cloud)) : std::nullopt;
+  ImportResult result;
+  runTransaction(db, [&] {
+    result = ImportResult{};
+    writeImport(db, meta, analysis, cloud, cloud_blob ? &*cloud_blob : nullptr, hook, result);
+  });
+  return result;
+}
+
 
 int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis, const std::string& software_version) {
   if (!hasSectionsArray(analysis))
