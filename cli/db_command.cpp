@@ -12,6 +12,7 @@
 #include "analysis/io/cloud_io.hpp"
 #include "analysis/pipeline/analysis_json.hpp"
 #include "cli/commands.hpp"
+#include "database/copy.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"
 #include "database/scan_record.hpp"
@@ -23,6 +24,7 @@ namespace {
 
 struct DbOptions {
   std::string db, file, dest;
+  bool append = false;
   int busy_timeout_ms = 5000;
   // import
   ImportMetadata meta;
@@ -56,9 +58,10 @@ OpenOptions openOptions(const DbOptions& o, bool create) {
 
 // Every db command but init works on an existing file; SQLite's own message
 // ("unable to open database file") does not say what to do about a missing one.
+// A PostgreSQL URL names a database on a server, which says itself when it is missing.
 void requireExisting(const DbOptions& o, const char* command) {
   std::error_code ec;
-  if (!std::filesystem::exists(o.db, ec))
+  if (!isPostgresUrl(o.db) && !std::filesystem::exists(o.db, ec))
     throw InvalidInput(std::string("db ") + command + ": " + o.db + " does not exist; run `sailshape db init " + o.db +
                        "` first");
 }
@@ -310,29 +313,30 @@ void runExport(const DbOptions& o) {
 // foreign keys as it is (no migration); throws on any problem, one line.
 void runCheck(const DbOptions& o) {
   requireExisting(o, "check");
-  const std::string not_ours = "db check: " + o.db + ": not a sailshape database";
+  const bool postgres = isPostgresUrl(o.db);
   std::error_code ec;
-  if (std::filesystem::file_size(o.db, ec) == 0 && !ec) throw DatabaseError(not_ours + " (empty file)");
+  if (!postgres && std::filesystem::file_size(o.db, ec) == 0 && !ec)
+    throw DatabaseError("db check: " + o.db + ": not a sailshape database (empty file)");
   Database d(o.db, openOptions(o, false));
+  const std::string not_ours = "db check: " + d.path() + ": not a sailshape database";
+  const char* kind = postgres ? "a PostgreSQL database" : "an SQLite database";
   const int version = d.userVersion();
   if (version > kSchemaVersion)
-    throw DatabaseError("db check: " + o.db + ": database schema version " + std::to_string(version) +
+    throw DatabaseError("db check: " + d.path() + ": database schema version " + std::to_string(version) +
                         " is newer than this sailshape (" + std::to_string(kSchemaVersion) + ")");
   if (version == 0) {
-    Statement tables(d, "SELECT count(*) FROM sqlite_schema WHERE type = 'table'");
-    tables.step();
-    const int64_t n = tables.columnInt(0);
+    const int64_t n = d.tableCount();
     if (n > 0)
-      throw DatabaseError(not_ours + " (an SQLite database of another application: " + std::to_string(n) +
+      throw DatabaseError(not_ours + " (" + kind + " of another application: " + std::to_string(n) +
                           (n == 1 ? " table" : " tables") + ", no sailshape schema)");
-    throw DatabaseError(not_ours + " (an SQLite database without tables; `sailshape db init " + o.db + "` makes it one)");
+    throw DatabaseError(not_ours + " (" + kind + " without tables; `sailshape db init " + d.path() + "` makes it one)");
   }
   std::vector<std::string> problems;
   try {
     problems = d.integrityCheck();
   } catch (const DatabaseError& e) {
     // SQLite stops the check at pages it cannot read at all.
-    throw DatabaseError("db check: " + o.db + ": damaged: the integrity check stopped at an unreadable page (" +
+    throw DatabaseError("db check: " + d.path() + ": damaged: the integrity check stopped at an unreadable page (" +
                         userMessage(e.what()) + ")");
   }
   // integrity_check heads its list with the database it checked; not a problem.
@@ -345,11 +349,46 @@ void runCheck(const DbOptions& o) {
       for (size_t i = 0; i < std::min(problems.size(), kListed); ++i) std::fprintf(stderr, "  %s\n", problems[i].c_str());
       if (problems.size() > kListed) std::fprintf(stderr, "  ... and %zu more\n", problems.size() - kListed);
     }
-    throw DatabaseError("db check: " + o.db + ": damaged: " + std::to_string(problems.size()) + " integrity problem" +
+    throw DatabaseError("db check: " + d.path() + ": damaged: " + std::to_string(problems.size()) + " integrity problem" +
                         (problems.size() == 1 ? "" : "s") + ", first: " + problems[0] +
                         (verbose() ? "" : " (--verbose lists them)"));
   }
-  std::printf("%s: ok (schema version %d)\n", o.db.c_str(), version);
+  std::printf("%s: ok (schema version %d)\n", d.path().c_str(), version);
+}
+
+// `db copy`: every row of DB into DEST in one transaction on DEST; a DEST file
+// this command created is removed again when the copy fails.
+void runCopy(const DbOptions& o) {
+  Database source = openExisting(o, "copy");
+  std::error_code ec;
+  const bool new_file = !isPostgresUrl(o.dest) && !std::filesystem::exists(o.dest, ec);
+  try {
+    Database dest = openSailDatabase(o.dest, openOptions(o, true));
+    CopyOptions options;
+    options.append = o.append;
+    CopyResult r;
+    try {
+      r = copyStore(source, dest, options);
+    } catch (const InvalidInput& e) {
+      std::string what = userMessage(e.what());
+      const std::string library_advice = "; copy into an empty store, or append to it";
+      const size_t advice = what.find(library_advice);
+      if (advice == std::string::npos) throw;
+      throw InvalidInput("db copy: " + what.replace(advice, library_advice.size(), "; --append adds to it"));
+    }
+    auto rows = [&](const std::string& table) {
+      for (const auto& [name, n] : r.rows_added)
+        if (name == table) return n;
+      return size_t{0};
+    };
+    std::printf("copied %zu rows (%zu scans, %zu analyses, %zu sections) from %s to %s\n", r.total_rows, rows("scans"),
+                rows("analyses"), rows("sections"), source.path().c_str(), dest.path().c_str());
+  } catch (...) {
+    if (new_file) {
+      for (const char* tail : {"", "-wal", "-shm"}) std::filesystem::remove(o.dest + tail, ec);
+    }
+    throw;
+  }
 }
 
 }  // namespace
@@ -358,11 +397,14 @@ void addDbCommand(CLI::App& app) {
   auto o = std::make_shared<DbOptions>();
   CLI::App* db = app.add_subcommand(
       "db", "The design-flying database: store scans with their trim steps, query, export, check\n\n"
-            "The design-flying database (one SQLite file): store scans with their trim steps and analyses, query them, "
-            "export, check and back up.");
+            "The design-flying database: store scans with their trim steps and analyses, query them, export, check, "
+            "back up and copy. DB is an SQLite file (embedded, the default) or a PostgreSQL server's database, "
+            "postgresql://USER@HOST:PORT/DBNAME (a loft's shared store: the password comes from ~/.pgpass or "
+            "PGPASSWORD, sslmode=require and the like as libpq reads them; the database must exist, `db init` makes "
+            "the schema). Every command below takes either.");
   db->require_subcommand(1);
   auto add_db = [&](CLI::App* cmd) {
-    cmd->add_option("DB", o->db, "Database file (SQLite)")->required();
+    cmd->add_option("DB", o->db, "Database: an SQLite file, or postgresql://USER@HOST:PORT/DBNAME")->required();
     cmd->add_option("--busy-timeout", o->busy_timeout_ms,
                     "Milliseconds to wait for another writer's lock before failing (default 5000)")
         ->check(CLI::NonNegativeNumber);
@@ -372,7 +414,7 @@ void addDbCommand(CLI::App& app) {
   add_db(init);
   init->callback([o] {
     Database d = openSailDatabase(o->db, openOptions(*o, true));
-    std::printf("%s: schema version %d\n", o->db.c_str(), d.userVersion());
+    std::printf("%s: schema version %d\n", d.path().c_str(), d.userVersion());
   });
 
   CLI::App* imp = db->add_subcommand(
@@ -424,7 +466,23 @@ void addDbCommand(CLI::App& app) {
   add_db(check);
   check->callback([o] { runCheck(*o); });
 
-  CLI::App* backup = db->add_subcommand("backup", "Copy the database online (SQLite backup API) to DEST");
+  CLI::App* copy = db->add_subcommand(
+      "copy",
+      "Copy every row of DB into DEST (SQLite file or PostgreSQL URL) in one transaction\n\n"
+      "Copy every row of DB into DEST, in one transaction on DEST: all of it or, on any error, nothing. Either may be "
+      "an SQLite file or a PostgreSQL URL, so a tunnel laptop's file goes to the loft's server and the server's "
+      "store comes back as a file. DEST is created when it is a missing file; a DEST that holds rows is refused "
+      "unless --append is given. Without --append every row keeps its id, so scan ids stay valid.");
+  add_db(copy);
+  copy->add_option("DEST", o->dest, "Destination: an SQLite file (created when missing) or postgresql://USER@HOST:PORT/DBNAME")
+      ->required();
+  copy->add_flag("--append", o->append,
+                 "Add to a DEST that already holds rows: scans, analyses and calibrations get new ids; campaigns, "
+                 "boats, sails, scanner units, sessions and trim steps DEST already has (by name; a trim step by "
+                 "session, sail, test and order) are used as they are there");
+  copy->callback([o] { runCopy(*o); });
+
+  CLI::App* backup = db->add_subcommand("backup", "Copy an SQLite database file online (SQLite backup API) to DEST");
   add_db(backup);
   backup->add_option("DEST", o->dest, "Destination file (replaced)")->required();
   backup->callback([o] {

@@ -59,6 +59,7 @@ const std::vector<CommandExamples>& examples() {
         "sailshape db export demo-output/sailshape.db twist.json --test 'A2 tack ease' --evolution twist_deg --json"}},
       {"db check", {"sailshape db check trials.db"}},
       {"db backup", {"sailshape db backup trials.db trials-backup.db"}},
+      {"db copy", {"sailshape db copy trials.db trials-copy.db", "sailshape db copy trials.db trials-copy.db --append"}},
       {"replay",
        {"sailshape replay demo-output/captures/step1-tunnel-main-lms511.sscap --json frames.json",
         "sailshape replay demo-output/captures/step1-tunnel-main-lms511.sscap --unit "

@@ -17,7 +17,7 @@ int64_t sailId(Database& db, const std::string& sail, const char* function) {
 }
 
 int64_t unitId(Database& db, const std::string& serial) {
-  db.prepare("INSERT OR IGNORE INTO scanner_units(serial) VALUES (?)").bind(1, serial).run();
+  db.prepare("INSERT INTO scanner_units(serial) VALUES (?) ON CONFLICT DO NOTHING").bind(1, serial).run();
   Statement s = db.prepare("SELECT id FROM scanner_units WHERE serial = ?");
   s.bind(1, serial).step();
   return s.columnInt(0);
@@ -66,20 +66,21 @@ Mesh unpackMesh(const std::vector<uint8_t>& blob) {
 
 int64_t upsertSail(Database& db, const SailInfo& info, const Mesh* design_mesh, const nlohmann::json* design_params) {
   if (info.name.empty()) throw InvalidInput("[upsertSail] sail name must not be empty");
-  Transaction tx(db);
-  db.prepare("INSERT OR IGNORE INTO sails(name) VALUES (?)").bind(1, info.name).run();
-  const int64_t id = sailId(db, info.name, "upsertSail");
-  setIfGiven(db, "type", info.type, id);
-  setIfGiven(db, "size_variant", info.size_variant, id);
-  setIfGiven(db, "designer", info.designer, id);
-  setIfGiven(db, "version", info.version, id);
-  if (!info.boat.empty()) {
-    db.prepare("INSERT OR IGNORE INTO boats(name) VALUES (?)").bind(1, info.boat).run();
-    db.prepare("UPDATE sails SET boat_id = (SELECT id FROM boats WHERE name = ?) WHERE id = ?").bind(1, info.boat).bind(2, id).run();
-  }
-  if (design_mesh) db.prepare("UPDATE sails SET design_mesh = ? WHERE id = ?").bindBlob(1, packMesh(*design_mesh)).bind(2, id).run();
-  if (design_params) db.prepare("UPDATE sails SET design_params = ? WHERE id = ?").bind(1, design_params->dump()).bind(2, id).run();
-  tx.commit();
+  int64_t id = 0;
+  runTransaction(db, [&] {
+    db.prepare("INSERT INTO sails(name) VALUES (?) ON CONFLICT DO NOTHING").bind(1, info.name).run();
+    id = sailId(db, info.name, "upsertSail");
+    setIfGiven(db, "type", info.type, id);
+    setIfGiven(db, "size_variant", info.size_variant, id);
+    setIfGiven(db, "designer", info.designer, id);
+    setIfGiven(db, "version", info.version, id);
+    if (!info.boat.empty()) {
+      db.prepare("INSERT INTO boats(name) VALUES (?) ON CONFLICT DO NOTHING").bind(1, info.boat).run();
+      db.prepare("UPDATE sails SET boat_id = (SELECT id FROM boats WHERE name = ?) WHERE id = ?").bind(1, info.boat).bind(2, id).run();
+    }
+    if (design_mesh) db.prepare("UPDATE sails SET design_mesh = ? WHERE id = ?").bindBlob(1, packMesh(*design_mesh)).bind(2, id).run();
+    if (design_params) db.prepare("UPDATE sails SET design_params = ? WHERE id = ?").bind(1, design_params->dump()).bind(2, id).run();
+  });
   return id;
 }
 
@@ -94,12 +95,13 @@ Mesh sailDesignMesh(Database& db, const std::string& sail) {
 int64_t addCalibration(Database& db, const std::string& serial, const Calibration& c) {
   if (serial.empty()) throw InvalidInput("[addCalibration] scanner serial must not be empty");
   if (c.calibrated_at.empty()) throw InvalidInput("[addCalibration] calibrated_at must not be empty");
-  Transaction tx(db);
-  const int64_t unit = unitId(db, serial);
-  db.prepare("INSERT INTO calibrations(unit_id, calibrated_at, p_m, theta_deg) VALUES (?, ?, ?, ?)")
-      .bind(1, unit).bind(2, c.calibrated_at).bind(3, c.p_m).bind(4, c.theta_deg).run();
-  const int64_t id = db.lastInsertId();
-  tx.commit();
+  int64_t id = 0;
+  runTransaction(db, [&] {
+    const int64_t unit = unitId(db, serial);
+    db.prepare("INSERT INTO calibrations(unit_id, calibrated_at, p_m, theta_deg) VALUES (?, ?, ?, ?)")
+        .bind(1, unit).bind(2, c.calibrated_at).bind(3, c.p_m).bind(4, c.theta_deg).run();
+    id = db.lastInsertId();
+  });
   return id;
 }
 

@@ -140,50 +140,9 @@ int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, 
   return analysis_id;
 }
 
-bool hasSectionsArray(const nlohmann::json& doc) {
-  return doc.is_object() && doc.contains("sections") && doc["sections"].is_array();
-}
-
-}  // namespace
-
-std::vector<uint8_t> packCurve(const std::vector<Vec3>& curve) {
-  std::vector<uint8_t> out(curve.size() * 24);
-  for (size_t i = 0; i < curve.size(); ++i) std::memcpy(out.data() + 24 * i, curve[i].data(), 24);
-  return out;
-}
-
-std::vector<Vec3> unpackCurve(const std::vector<uint8_t>& blob) {
-  if (blob.size() % 24 != 0)
-    throw DatabaseError("[unpackCurve] curve blob of " + std::to_string(blob.size()) + " bytes is not N×3 float64");
-  std::vector<Vec3> curve(blob.size() / 24);
-  for (size_t i = 0; i < curve.size(); ++i) std::memcpy(curve[i].data(), blob.data() + 24 * i, 24);
-  return curve;
-}
-
-ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
-                        const ImportHook& hook) {
-  if (meta.campaign.empty()) throw InvalidInput("[importScan] campaign name must not be empty");
-  if (meta.sail.empty()) throw InvalidInput("[importScan] sail name must not be empty");
-  if (meta.campaign_kind != "full_scale" && meta.campaign_kind != "wind_tunnel")
-    throw InvalidInput("[importScan] campaign_kind must be full_scale or wind_tunnel (got \"" + meta.campaign_kind + "\")");
-  requireFinite(meta.awa_deg, "awa_deg");
-  requireFinite(meta.aws_m_s, "aws_m_s");
-  if (meta.awa_deg && (*meta.awa_deg < -180 || *meta.awa_deg > 360))
-    throw InvalidInput("[importScan] awa_deg must be in [-180, 360] (got " + std::to_string(*meta.awa_deg) + ")");
-  if (!analysis && !cloud) throw InvalidInput("[importScan] nothing to import: neither an analysis nor a cloud");
-  if (analysis && !hasSectionsArray(*analysis))
-    throw InvalidInput("[importScan] the analysis document has no \"sections\" array (is it `sailshape analyze --json` output?)");
-  if (analysis && analysis->contains("diagnostics") && !(*analysis)["diagnostics"].is_object())
-    throw InvalidInput("[importScan] the analysis document's diagnostics must be an object (got " +
-                       std::string((*analysis)["diagnostics"].type_name()) + ")");
-  for (const auto& [name, value] : meta.controls)
-    if (name.empty() || !std::isfinite(value))
-      throw InvalidInput("[importScan] control setting \"" + name + "\" needs a name and a finite value (got " +
-                         std::to_string(value) + ")");
-
-  ImportResult result;
-  Transaction tx(db);
-
+// Every row of one import; the caller holds the transaction.
+void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
+                 const std::vector<uint8_t>* cloud_blob, const ImportHook& hook, ImportResult& result) {
   Statement c = db.prepare("SELECT id FROM campaigns WHERE name = ?");
   c.bind(1, meta.campaign);
   int64_t campaign_id;
@@ -213,8 +172,14 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
     boat_id = findOrCreate(db, "SELECT id FROM boats WHERE name = ?", "INSERT INTO boats(name) VALUES (?)", meta.boat);
   const int64_t sail_id =
       findOrCreate(db, "SELECT id FROM sails WHERE name = ?", "INSERT INTO sails(name) VALUES (?)", meta.sail);
-  if (!meta.sail_type.empty()) db.prepare("UPDATE sails SET type = ? WHERE id = ?").bind(1, meta.sail_type).bind(2, sail_id).run();
-  if (boat_id) db.prepare("UPDATE sails SET boat_id = ? WHERE id = ?").bind(1, *boat_id).bind(2, sail_id).run();
+  // Written only when it changes: concurrent importers of one sail then do not
+  // all write its row (on PostgreSQL each such write would abort the others).
+  if (!meta.sail_type.empty())
+    db.prepare("UPDATE sails SET type = ? WHERE id = ? AND (type IS NULL OR type <> ?)")
+        .bind(1, meta.sail_type).bind(2, sail_id).bind(3, meta.sail_type).run();
+  if (boat_id)
+    db.prepare("UPDATE sails SET boat_id = ? WHERE id = ? AND (boat_id IS NULL OR boat_id <> ?)")
+        .bind(1, *boat_id).bind(2, sail_id).bind(3, *boat_id).run();
 
   std::optional<int64_t> unit_id;
   if (!meta.scanner_unit.empty())
@@ -240,12 +205,14 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
     i.bind(6, meta.aws_m_s).bind(7, meta.drive_n).bind(8, meta.side_n).bind(9, meta.heel_moment_nm).run();
     result.trim_step_id = db.lastInsertId();
   }
-  Statement cs = db.prepare("INSERT OR REPLACE INTO control_settings(trim_step_id, name, value) VALUES (?, ?, ?)");
+  Statement cs = db.prepare("INSERT INTO control_settings(trim_step_id, name, value) VALUES (?, ?, ?)"
+                            " ON CONFLICT (trim_step_id, name) DO UPDATE SET value = excluded.value");
   for (const auto& [name, value] : meta.controls) {
     cs.bind(1, result.trim_step_id).bind(2, name).bind(3, value).run();
     cs.reset();
   }
-  Statement pr = db.prepare("INSERT OR REPLACE INTO pressures(trim_step_id, tap, pressure_pa) VALUES (?, ?, ?)");
+  Statement pr = db.prepare("INSERT INTO pressures(trim_step_id, tap, pressure_pa) VALUES (?, ?, ?)"
+                            " ON CONFLICT (trim_step_id, tap) DO UPDATE SET pressure_pa = excluded.pressure_pa");
   for (const auto& [tap, value] : meta.pressures_pa) {
     pr.bind(1, result.trim_step_id).bind(2, tap).bind(3, value).run();
     pr.reset();
@@ -264,7 +231,7 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
   if (meta.scanned_at.empty()) s.bindNull(3); else s.bind(3, meta.scanned_at);
   if (meta.settings.is_null()) s.bindNull(4); else s.bind(4, meta.settings.dump());
   if (meta.raw_capture.empty()) s.bindNull(5); else s.bind(5, meta.raw_capture);
-  if (cloud) s.bindBlob(6, compressCloud(*cloud)); else s.bindNull(6);
+  if (cloud_blob) s.bindBlob(6, *cloud_blob); else s.bindNull(6);
   s.bind(7, static_cast<int64_t>(point_count)).run();
   result.scan_id = db.lastInsertId();
   if (hook) hook("scan");
@@ -274,9 +241,63 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
         writeAnalysis(db, result.scan_id, *analysis, meta.software_version, "importScan", &result.sections, hook);
     if (hook) hook("sections");
   }
-  tx.commit();
+}
+
+
+bool hasSectionsArray(const nlohmann::json& doc) {
+  return doc.is_object() && doc.contains("sections") && doc["sections"].is_array();
+}
+
+}  // namespace
+
+std::vector<uint8_t> packCurve(const std::vector<Vec3>& curve) {
+  std::vector<uint8_t> out(curve.size() * 24);
+  for (size_t i = 0; i < curve.size(); ++i) std::memcpy(out.data() + 24 * i, curve[i].data(), 24);
+  return out;
+}
+
+std::vector<Vec3> unpackCurve(const std::vector<uint8_t>& blob) {
+  if (blob.size() % 24 != 0)
+    throw DatabaseError("[unpackCurve] curve blob of " + std::to_string(blob.size()) + " bytes is not N×3 float64");
+  std::vector<Vec3> curve(blob.size() / 24);
+  for (size_t i = 0; i < curve.size(); ++i) std::memcpy(curve[i].data(), blob.data() + 24 * i, 24);
+  return curve;
+}
+
+
+ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
+                        const ImportHook& hook) {
+  if (meta.campaign.empty()) throw InvalidInput("[importScan] campaign name must not be empty");
+  if (meta.sail.empty()) throw InvalidInput("[importScan] sail name must not be empty");
+  if (meta.campaign_kind != "full_scale" && meta.campaign_kind != "wind_tunnel")
+    throw InvalidInput("[importScan] campaign_kind must be full_scale or wind_tunnel (got \"" + meta.campaign_kind + "\")");
+  requireFinite(meta.awa_deg, "awa_deg");
+  requireFinite(meta.aws_m_s, "aws_m_s");
+  if (meta.awa_deg && (*meta.awa_deg < -180 || *meta.awa_deg > 360))
+    throw InvalidInput("[importScan] awa_deg must be in [-180, 360] (got " + std::to_string(*meta.awa_deg) + ")");
+  if (!analysis && !cloud) throw InvalidInput("[importScan] nothing to import: neither an analysis nor a cloud");
+  if (analysis && !hasSectionsArray(*analysis))
+    throw InvalidInput("[importScan] the analysis document has no \"sections\" array (is it `sailshape analyze --json` output?)");
+  if (analysis && analysis->contains("diagnostics") && !(*analysis)["diagnostics"].is_object())
+    throw InvalidInput("[importScan] the analysis document's diagnostics must be an object (got " +
+                       std::string((*analysis)["diagnostics"].type_name()) + ")");
+  for (const auto& [name, value] : meta.controls)
+    if (name.empty() || !std::isfinite(value))
+      throw InvalidInput("[importScan] control setting \"" + name + "\" needs a name and a finite value (got " +
+                         std::to_string(value) + ")");
+
+  // Compressed before the transaction: it is the import's longest step, and the
+  // write lock (SQLite) or a retry (PostgreSQL) need not wait for it again.
+  const std::optional<std::vector<uint8_t>> cloud_blob =
+      cloud ? std::optional<std::vector<uint8_t>>(compressCloud(*cloud)) : std::nullopt;
+  ImportResult result;
+  runTransaction(db, [&] {
+    result = ImportResult{};
+    writeImport(db, meta, analysis, cloud, cloud_blob ? &*cloud_blob : nullptr, hook, result);
+  });
   return result;
 }
+
 
 int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis, const std::string& software_version) {
   if (!hasSectionsArray(analysis))
@@ -284,12 +305,13 @@ int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysi
   if (analysis.contains("diagnostics") && !analysis["diagnostics"].is_object())
     throw InvalidInput("[addAnalysis] the analysis document's diagnostics must be an object (got " +
                        std::string(analysis["diagnostics"].type_name()) + ")");
-  Transaction tx(db);
-  Statement s = db.prepare("SELECT 1 FROM scans WHERE id = ?");
-  s.bind(1, scan_id);
-  if (!s.step()) throw InvalidInput("[addAnalysis] no scan with id " + std::to_string(scan_id));
-  const int64_t id = writeAnalysis(db, scan_id, analysis, software_version, "addAnalysis", nullptr, {});
-  tx.commit();
+  int64_t id = 0;
+  runTransaction(db, [&] {
+    Statement s = db.prepare("SELECT 1 FROM scans WHERE id = ?");
+    s.bind(1, scan_id);
+    if (!s.step()) throw InvalidInput("[addAnalysis] no scan with id " + std::to_string(scan_id));
+    id = writeAnalysis(db, scan_id, analysis, software_version, "addAnalysis", nullptr, {});
+  });
   return id;
 }
 

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "analysis/core/errors.hpp"
+#include "database/dialect.hpp"
 #include "database/scan_record.hpp"
 
 namespace sailshape {
@@ -18,8 +19,10 @@ const char* const kFrom =
     " JOIN sails sa ON sa.id = t.sail_id"
     " LEFT JOIN boats b ON b.id = sa.boat_id";
 
-const char* const kControls =
-    "(SELECT group_concat(cs.name || '=' || cs.value, ';') FROM control_settings cs WHERE cs.trim_step_id = t.id)";
+// The controls column carries the trim step's id until fillControls() replaces
+// it by its settings, "name=value;..." by name, each value as SQLite writes a
+// REAL: built here rather than by SQL so that both backends answer alike.
+const char* const kControls = "t.id";
 
 // The latest analysis of scan s.
 const char* const kLatestAnalysis = "(SELECT max(a.id) FROM analyses a WHERE a.scan_id = s.id)";
@@ -95,6 +98,36 @@ Table collect(Statement& s) {
   return t;
 }
 
+void fillControls(Database& db, Table& table) {
+  const auto column = std::find(table.columns.begin(), table.columns.end(), "controls");
+  if (column == table.columns.end()) return;
+  const size_t c = static_cast<size_t>(column - table.columns.begin());
+  std::vector<int64_t> ids;
+  for (const auto& row : table.rows)
+    if (const auto* id = std::get_if<int64_t>(&row[c])) ids.push_back(*id);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  std::map<int64_t, std::string> text;
+  constexpr size_t kPerQuery = 500;  // ids in one IN list
+  for (size_t first = 0; first < ids.size(); first += kPerQuery) {
+    std::string list;
+    for (size_t i = first; i < std::min(ids.size(), first + kPerQuery); ++i) list += (list.empty() ? "" : ",") + std::to_string(ids[i]);
+    Statement s = db.prepare("SELECT trim_step_id, name, value FROM control_settings WHERE trim_step_id IN (" + list +
+                             ") ORDER BY trim_step_id, name");
+    while (s.step()) {
+      std::string& t = text[s.columnInt(0)];
+      t += (t.empty() ? "" : ";") + s.columnText(1) + "=" + detail::sqliteRealText(s.columnDouble(2));
+    }
+  }
+  for (auto& row : table.rows) {
+    const auto* id = std::get_if<int64_t>(&row[c]);
+    if (!id) continue;
+    const auto found = text.find(*id);
+    if (found == text.end()) row[c] = std::monostate{};
+    else row[c] = found->second;
+  }
+}
+
 std::string sectionColumns(const std::string& alias) {
   std::string cols;
   for (const auto& p : sectionParameterNames()) cols += ", " + alias + "." + p;
@@ -126,7 +159,9 @@ Table findScans(Database& db, const ScanFilter& filter) {
   Statement s = db.prepare(std::string(kScanColumns) + kControls + " AS controls" + kFrom + w.sql +
                            " ORDER BY c.name, t.test, t.step_order, s.id");
   bindAll(s, w.args);
-  return collect(s);
+  Table t = collect(s);
+  fillControls(db, t);
+  return t;
 }
 
 Table findSections(Database& db, const ScanFilter& filter) {
@@ -151,10 +186,11 @@ Table parameterEvolution(Database& db, const std::string& test, const std::strin
       "SELECT t.step_order AS step, t.awa_deg, s.id AS scan_id, sa.name AS sail, x.fraction, x." + parameter +
       " AS value, x.u_" + parameter + " AS uncertainty, " + kControls + " AS controls" + kFrom +
       " JOIN sections x ON x.id = (SELECT y.id FROM sections y WHERE y.analysis_id = " + kLatestAnalysis +
-      " ORDER BY abs(y.fraction - ?) LIMIT 1)" + w.sql + " ORDER BY t.step_order, s.id");
+      " ORDER BY abs(y.fraction - ?), y.fraction LIMIT 1)" + w.sql + " ORDER BY t.step_order, s.id");
   s.bind(1, fraction);
   bindAll(s, w.args, 2);
   Table t = collect(s);
+  fillControls(db, t);
   // A step whose analysis was asked for a section nearer `fraction` than the one
   // found, and could not measure it, has no value there: the nearest measured one
   // belongs to another height.
@@ -237,7 +273,9 @@ Table bestTrimSteps(Database& db, double awa_min_deg, double awa_max_deg, TrimCr
       ", t.id LIMIT ?");
   bindAll(s, w.args);
   s.bind(static_cast<int>(w.args.size()) + 1, static_cast<int64_t>(limit));
-  return collect(s);
+  Table t = collect(s);
+  fillControls(db, t);
+  return t;
 }
 
 }  // namespace sailshape

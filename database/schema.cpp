@@ -1,5 +1,7 @@
 #include "database/schema.hpp"
 
+#include "database/dialect.hpp"
+
 namespace sailshape {
 namespace {
 
@@ -123,6 +125,29 @@ CREATE INDEX design_comparisons_analysis ON design_comparisons(analysis_id);
 
 }  // namespace
 
+namespace {
+
+// Holds the schema lock of a PostgreSQL store while migrations run, so two
+// processes opening a new store migrate it once.
+class SchemaLock {
+ public:
+  explicit SchemaLock(Database& db) : db_(db) { db_.lockSchema(true); }
+  ~SchemaLock() {
+    try {
+      db_.lockSchema(false);
+    } catch (const DatabaseError&) {
+      // A lost connection released the lock with the session.
+    }
+  }
+  SchemaLock(const SchemaLock&) = delete;
+  SchemaLock& operator=(const SchemaLock&) = delete;
+
+ private:
+  Database& db_;
+};
+
+}  // namespace
+
 void migrateSchema(Database& db, int target_version) {
   const int current = db.userVersion();
   if (current > kSchemaVersion)
@@ -131,11 +156,12 @@ void migrateSchema(Database& db, int target_version) {
   if (target_version < current || target_version > kSchemaVersion)
     throw DatabaseError("[migrateSchema] target_version must be in [" + std::to_string(current) + ", " +
                         std::to_string(kSchemaVersion) + "] (got " + std::to_string(target_version) + ")");
+  SchemaLock lock(db);
   for (int v = current; v < target_version; ++v) {
     Transaction tx(db);
     // Re-read under the write lock: another process may have migrated meanwhile.
     if (db.userVersion() != v) continue;
-    db.exec(kMigrations[v]);
+    db.exec(db.backend() == Backend::PostgreSQL ? detail::postgresDdl(kMigrations[v]) : std::string(kMigrations[v]));
     db.setUserVersion(v + 1);
     tx.commit();
   }
@@ -145,21 +171,19 @@ Database openSailDatabase(const std::string& path, const OpenOptions& options) {
   Database db(path, options);
   const int version = db.userVersion();
   if (version > kSchemaVersion)
-    throw DatabaseError("[openSailDatabase] " + path + ": database schema version " + std::to_string(version) +
+    throw DatabaseError("[openSailDatabase] " + db.path() + ": database schema version " + std::to_string(version) +
                         " is newer than this sailshape (" + std::to_string(kSchemaVersion) + ")");
-  if (version == 0) {
-    Statement tables(db, "SELECT count(*) FROM sqlite_schema");
-    tables.step();
-    if (tables.columnInt(0) > 0)
-      throw DatabaseError("[openSailDatabase] " + path +
-                          ": an SQLite database of another application (tables but no sailshape schema); left untouched");
-  }
-  // WAL: readers (the viewer) keep reading while a scan is written.
-  if (!db.readOnly()) db.exec("PRAGMA journal_mode=WAL");
+  if (version == 0 && db.tableCount() > 0)
+    throw DatabaseError("[openSailDatabase] " + db.path() + ": " +
+                        (db.backend() == Backend::SQLite ? "an SQLite database" : "a PostgreSQL database") +
+                        " of another application (tables but no sailshape schema); left untouched");
+  // Readers (the viewer) keep reading while a scan is written.
+  db.enableConcurrentReaders();
   if (version < kSchemaVersion) {
     if (db.readOnly())
-      throw DatabaseError("[openSailDatabase] " + path + ": schema version " + std::to_string(version) +
-                          " needs a migration; open it writable (the file or its folder is read-only here)");
+      throw DatabaseError("[openSailDatabase] " + db.path() + ": schema version " + std::to_string(version) +
+                          " needs a migration; open it writable (" +
+                          (db.backend() == Backend::SQLite ? "the file or its folder is read-only here" : "it was opened read-only") + ")");
     migrateSchema(db);
   }
   return db;

@@ -774,7 +774,7 @@ void validate(const TrimReportParams& p) {
   if (p.scan_id.has_value() == !p.test.empty())
     throw InvalidInput("[writeTrimReport] give exactly one of a scan id and a test name");
   if (p.db_path.empty()) throw InvalidInput("[writeTrimReport] no database given");
-  if (!std::filesystem::exists(p.db_path))
+  if (!isPostgresUrl(p.db_path) && !std::filesystem::exists(p.db_path))
     throw InvalidInput("[writeTrimReport] database " + p.db_path + " does not exist");
 }
 

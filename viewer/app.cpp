@@ -74,7 +74,7 @@ void App::openDatabase(const std::string& path) {
   processing_.result.reset();
   pick_ = PickState{};
   view_.rebuild = true;
-  if (!std::filesystem::exists(path)) {
+  if (!isPostgresUrl(path) && !std::filesystem::exists(path)) {
     database_.error = "database file not found: " + path;
     log_.error(database_.error);
     initial_load_done_ = true;

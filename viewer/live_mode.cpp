@@ -53,7 +53,7 @@ void LiveMode::start(const ScannerSession& session, LiveParams params) {
     throw InvalidInput("[LiveMode::start] no scanner unit: load a unit file or add an emulated unit");
   if (params.max_sweeps < 0)
     throw InvalidInput("[LiveMode::start] max_sweeps must be >= 0 (got " + std::to_string(params.max_sweeps) + ")");
-  if (!params.save_to.empty() && !std::filesystem::exists(params.save_to))
+  if (!params.save_to.empty() && !isPostgresUrl(params.save_to) && !std::filesystem::exists(params.save_to))
     throw InvalidInput("[LiveMode::start] database file not found: " + params.save_to);
   parseControls(params.form.controls);  // a bad entry is refused now, not at the first store
   if (running()) throw std::logic_error("[LiveMode::start] live mode is already running");

@@ -96,8 +96,8 @@ void collectHelps(const fs::path& dir, const std::string& path, std::vector<std:
 TEST_F(Cli, EveryCommandsHelpEndsWithExamplesOfItself) {
   std::vector<std::pair<std::string, std::string>> helps;
   collectHelps(dir_, "", helps);
-  // sailshape, its 12 commands, design's 2, db's 8 and scanner's 1.
-  ASSERT_EQ(helps.size(), 24u);
+  // sailshape, its 12 commands, design's 2, db's 9 and scanner's 1.
+  ASSERT_EQ(helps.size(), 25u);
   for (const auto& [path, help] : helps) {
     const size_t examples = help.find("\nExamples:\n");
     ASSERT_NE(examples, std::string::npos) << "`sailshape " << path << " --help` has no examples:\n" << help;
@@ -139,7 +139,7 @@ TEST_F(Cli, ExamplesRunAsWritten) {
   const std::string bin_dir = fs::path(SAILSHAPE_BIN).parent_path().string();
   int ran = 0;
   for (const char* command : {"analyze", "simulate", "design", "design new", "design show", "compare", "db", "db init",
-                              "db import", "db list", "db show", "db query", "db export", "db check", "db backup"}) {
+                              "db import", "db list", "db show", "db query", "db export", "db check", "db backup", "db copy"}) {
     const Outcome help = sailshape(std::string(command) + " --help");
     for (const std::string& example : examplesOf(help.out)) {
       if (example.find("demo-output") != std::string::npos) continue;  // needs `sailshape demo` first
@@ -153,6 +153,7 @@ TEST_F(Cli, ExamplesRunAsWritten) {
   }
   EXPECT_GE(ran, 25);
   EXPECT_TRUE(fs::exists(dir_ / "trials-backup.db"));
+  EXPECT_TRUE(fs::exists(dir_ / "trials-copy.db"));
   EXPECT_TRUE(fs::exists(dir_ / "sections.csv"));
 }
 

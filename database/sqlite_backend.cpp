@@ -1,4 +1,4 @@
-#include "database/sqlite.hpp"
+#include "database/backend.hpp"
 
 #include <sqlite3.h>
 #include <unistd.h>
@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <utility>
 
-namespace sailshape {
+namespace sailshape::detail {
 namespace {
 
 std::string describe(sqlite3* db, int rc) {
@@ -44,9 +44,98 @@ std::string immutableUri(const std::string& path) {
   return uri + "?immutable=1";
 }
 
-}  // namespace
 
-void Database::check(int rc, const char* what) const {
+class SqliteConnection;
+
+class SqliteStatement : public StatementBackend {
+ public:
+  SqliteStatement(SqliteConnection& db, const std::string& sql);
+  ~SqliteStatement() override {
+    if (stmt_) sqlite3_finalize(stmt_);
+  }
+  void bindInt(int index, int64_t value) override;
+  void bindDouble(int index, double value) override;
+  void bindText(int index, const std::string& value) override;
+  void bindBlob(int index, const std::vector<uint8_t>& value) override;
+  void bindNull(int index) override;
+  bool step() override;
+  void reset() override {
+    sqlite3_reset(stmt_);
+    sqlite3_clear_bindings(stmt_);
+  }
+  int columnCount() const override { return sqlite3_column_count(stmt_); }
+  std::string columnName(int c) const override { return sqlite3_column_name(stmt_, c); }
+  bool isNull(int c) const override { return sqlite3_column_type(stmt_, c) == SQLITE_NULL; }
+  bool isInteger(int c) const override { return sqlite3_column_type(stmt_, c) == SQLITE_INTEGER; }
+  bool isFloat(int c) const override { return sqlite3_column_type(stmt_, c) == SQLITE_FLOAT; }
+  bool isBlob(int c) const override { return sqlite3_column_type(stmt_, c) == SQLITE_BLOB; }
+  int64_t columnInt(int c) const override { return sqlite3_column_int64(stmt_, c); }
+  double columnDouble(int c) const override { return sqlite3_column_double(stmt_, c); }
+  std::string columnText(int c) const override {
+    const unsigned char* t = sqlite3_column_text(stmt_, c);
+    return t ? std::string(reinterpret_cast<const char*>(t), sqlite3_column_bytes(stmt_, c)) : std::string();
+  }
+  std::vector<uint8_t> columnBlob(int c) const override {
+    const auto* p = static_cast<const uint8_t*>(sqlite3_column_blob(stmt_, c));
+    return p ? std::vector<uint8_t>(p, p + sqlite3_column_bytes(stmt_, c)) : std::vector<uint8_t>();
+  }
+
+ private:
+  SqliteConnection* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+class SqliteConnection : public ConnectionBackend {
+ public:
+  SqliteConnection(const std::string& path, const OpenOptions& options);
+  ~SqliteConnection() override {
+    if (db_) sqlite3_close_v2(db_);
+  }
+  Backend kind() const override { return Backend::SQLite; }
+  void exec(const std::string& sql) override {
+    char* err = nullptr;
+    const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err);
+    sqlite3_free(err);
+    check(rc, "Database::exec");
+  }
+  std::unique_ptr<StatementBackend> prepare(const std::string& sql) override {
+    return std::make_unique<SqliteStatement>(*this, sql);
+  }
+  int64_t lastInsertId() override { return sqlite3_last_insert_rowid(db_); }
+  bool readOnly() const override { return sqlite3_db_readonly(db_, "main") == 1; }
+  int userVersion() override {
+    SqliteStatement s(*this, "PRAGMA user_version");
+    s.step();
+    return static_cast<int>(s.columnInt(0));
+  }
+  void setUserVersion(int version) override { exec("PRAGMA user_version=" + std::to_string(version)); }
+  int64_t tableCount() override {
+    SqliteStatement s(*this, "SELECT count(*) FROM sqlite_schema WHERE type = 'table'");
+    s.step();
+    return s.columnInt(0);
+  }
+  std::vector<std::string> integrityCheck() override;
+  void backupTo(const std::string& dest_path) override;
+  void begin() override { exec("BEGIN IMMEDIATE"); }
+  void commit() override { exec("COMMIT"); }
+  void rollback() noexcept override { sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr); }
+  void beginSnapshot() override { exec("BEGIN"); }
+  void lockSchema(bool) override {}
+  void enableConcurrentReaders() override {
+    if (!readOnly()) exec("PRAGMA journal_mode=WAL");
+  }
+
+  sqlite3* handle() const { return db_; }
+  // Throws DatabaseError (DatabaseBusy for SQLITE_BUSY/LOCKED) when `rc` is an error.
+  void check(int rc, const char* what) const;
+
+ private:
+  sqlite3* db_ = nullptr;
+  std::string path_;
+  int busy_timeout_ms_ = 0;
+};
+
+void SqliteConnection::check(int rc, const char* what) const {
   if (rc == SQLITE_OK || rc == SQLITE_ROW || rc == SQLITE_DONE) return;
   const int primary = rc & 0xff;
   if (primary == SQLITE_BUSY || primary == SQLITE_LOCKED)
@@ -59,7 +148,7 @@ void Database::check(int rc, const char* what) const {
   throw DatabaseError(std::string("[") + what + "] " + path_ + ": " + describe(db_, rc));
 }
 
-Database::Database(const std::string& path, const OpenOptions& options)
+SqliteConnection::SqliteConnection(const std::string& path, const OpenOptions& options)
     : path_(path), busy_timeout_ms_(options.busy_timeout_ms) {
   if (options.busy_timeout_ms < 0)
     throw DatabaseError("[Database] busy_timeout_ms must be >= 0 (got " + std::to_string(options.busy_timeout_ms) + ")");
@@ -95,59 +184,21 @@ Database::Database(const std::string& path, const OpenOptions& options)
   }
 }
 
-Database::~Database() {
-  if (db_) sqlite3_close_v2(db_);
-}
-
-Database::Database(Database&& other) noexcept
-    : db_(std::exchange(other.db_, nullptr)), path_(std::move(other.path_)), busy_timeout_ms_(other.busy_timeout_ms_) {}
-
-Database& Database::operator=(Database&& other) noexcept {
-  if (this != &other) {
-    if (db_) sqlite3_close_v2(db_);
-    db_ = std::exchange(other.db_, nullptr);
-    path_ = std::move(other.path_);
-    busy_timeout_ms_ = other.busy_timeout_ms_;
-  }
-  return *this;
-}
-
-void Database::exec(const std::string& sql) {
-  char* err = nullptr;
-  const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err);
-  sqlite3_free(err);
-  check(rc, "Database::exec");
-}
-
-Statement Database::prepare(const std::string& sql) { return Statement(*this, sql); }
-
-bool Database::readOnly() const { return sqlite3_db_readonly(db_, "main") == 1; }
-
-int64_t Database::lastInsertId() const { return sqlite3_last_insert_rowid(db_); }
-
-int Database::userVersion() {
-  Statement s(*this, "PRAGMA user_version");
-  s.step();
-  return static_cast<int>(s.columnInt(0));
-}
-
-void Database::setUserVersion(int version) { exec("PRAGMA user_version=" + std::to_string(version)); }
-
-std::vector<std::string> Database::integrityCheck() {
+std::vector<std::string> SqliteConnection::integrityCheck() {
   std::vector<std::string> problems;
-  Statement s(*this, "PRAGMA integrity_check");
+  SqliteStatement s(*this, "PRAGMA integrity_check");
   while (s.step()) {
     std::string line = s.columnText(0);
     if (line != "ok") problems.push_back(line);
   }
-  Statement fk(*this, "PRAGMA foreign_key_check");
+  SqliteStatement fk(*this, "PRAGMA foreign_key_check");
   while (fk.step())
     problems.push_back("foreign key: row " + fk.columnText(1) + " of " + fk.columnText(0) + " refers to a missing row of " +
                        fk.columnText(2));
   return problems;
 }
 
-void Database::backupTo(const std::string& dest_path) {
+void SqliteConnection::backupTo(const std::string& dest_path) {
   sqlite3* dest = nullptr;
   int rc = sqlite3_open_v2(dest_path.c_str(), &dest, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
   if (rc != SQLITE_OK) {
@@ -175,44 +226,27 @@ void Database::backupTo(const std::string& dest_path) {
     throw DatabaseError("[Database::backupTo] " + path_ + " -> " + dest_path + ": " + msg);
 }
 
-Statement::Statement(Database& db, const std::string& sql) : db_(&db), sql_(sql) {
+SqliteStatement::SqliteStatement(SqliteConnection& db, const std::string& sql) : db_(&db) {
   db_->check(sqlite3_prepare_v2(db.handle(), sql.c_str(), static_cast<int>(sql.size()), &stmt_, nullptr),
              "Statement::prepare");
 }
 
-Statement::~Statement() {
-  if (stmt_) sqlite3_finalize(stmt_);
-}
-
-Statement::Statement(Statement&& other) noexcept
-    : db_(other.db_), stmt_(std::exchange(other.stmt_, nullptr)), sql_(std::move(other.sql_)) {}
-
-Statement& Statement::bind(int index, int64_t value) {
+void SqliteStatement::bindInt(int index, int64_t value) {
   db_->check(sqlite3_bind_int64(stmt_, index, value), "Statement::bind");
-  return *this;
 }
-Statement& Statement::bind(int index, double value) {
+void SqliteStatement::bindDouble(int index, double value) {
   db_->check(sqlite3_bind_double(stmt_, index, value), "Statement::bind");
-  return *this;
 }
-Statement& Statement::bind(int index, const std::string& value) {
+void SqliteStatement::bindText(int index, const std::string& value) {
   db_->check(sqlite3_bind_text(stmt_, index, value.data(), static_cast<int>(value.size()), SQLITE_TRANSIENT),
              "Statement::bind");
-  return *this;
 }
-Statement& Statement::bind(int index, const std::optional<double>& value) {
-  return value ? bind(index, *value) : bindNull(index);
-}
-Statement& Statement::bindBlob(int index, const std::vector<uint8_t>& value) {
+void SqliteStatement::bindBlob(int index, const std::vector<uint8_t>& value) {
   db_->check(sqlite3_bind_blob64(stmt_, index, value.data(), value.size(), SQLITE_TRANSIENT), "Statement::bind");
-  return *this;
 }
-Statement& Statement::bindNull(int index) {
-  db_->check(sqlite3_bind_null(stmt_, index), "Statement::bind");
-  return *this;
-}
+void SqliteStatement::bindNull(int index) { db_->check(sqlite3_bind_null(stmt_, index), "Statement::bind"); }
 
-bool Statement::step() {
+bool SqliteStatement::step() {
   const int rc = sqlite3_step(stmt_);
   if (rc == SQLITE_ROW) return true;
   if (rc == SQLITE_DONE) return false;
@@ -221,41 +255,10 @@ bool Statement::step() {
   return false;
 }
 
-void Statement::run() {
-  while (step()) {
-  }
+}  // namespace
+
+std::unique_ptr<ConnectionBackend> openSqlite(const std::string& path, const OpenOptions& options) {
+  return std::make_unique<SqliteConnection>(path, options);
 }
 
-void Statement::reset() {
-  sqlite3_reset(stmt_);
-  sqlite3_clear_bindings(stmt_);
-}
-
-int Statement::columnCount() const { return sqlite3_column_count(stmt_); }
-std::string Statement::columnName(int c) const { return sqlite3_column_name(stmt_, c); }
-bool Statement::isNull(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_NULL; }
-bool Statement::isInteger(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_INTEGER; }
-bool Statement::isFloat(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_FLOAT; }
-int64_t Statement::columnInt(int c) const { return sqlite3_column_int64(stmt_, c); }
-double Statement::columnDouble(int c) const { return sqlite3_column_double(stmt_, c); }
-std::string Statement::columnText(int c) const {
-  const unsigned char* t = sqlite3_column_text(stmt_, c);
-  return t ? std::string(reinterpret_cast<const char*>(t), sqlite3_column_bytes(stmt_, c)) : std::string();
-}
-std::vector<uint8_t> Statement::columnBlob(int c) const {
-  const auto* p = static_cast<const uint8_t*>(sqlite3_column_blob(stmt_, c));
-  return p ? std::vector<uint8_t>(p, p + sqlite3_column_bytes(stmt_, c)) : std::vector<uint8_t>();
-}
-
-Transaction::Transaction(Database& db) : db_(db) { db_.exec("BEGIN IMMEDIATE"); }
-
-Transaction::~Transaction() {
-  if (!done_) sqlite3_exec(db_.handle(), "ROLLBACK", nullptr, nullptr, nullptr);
-}
-
-void Transaction::commit() {
-  db_.exec("COMMIT");
-  done_ = true;
-}
-
-}  // namespace sailshape
+}  // namespace sailshape::detail
