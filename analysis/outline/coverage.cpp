@@ -1,13 +1,17 @@
 // Where the samples stop, and why (SPEC §3). From one unit the samples of a sail stop
 // where the sail ends, but also where the beams meet the cloth at grazing incidence
-// (returns fail beyond about 70°, none come back at grazing angles) or run out of
-// range. Seen from the cloud's viewpoint, each boundary point of the mesh tells which:
-// the incidence of the beam on the surface there, and its range. A corner whose
+// (returns fail beyond about 70°, none come back at grazing angles), run out of
+// range, or meet something in the way first (a mast, a stay: its shadow on the sail).
+// Seen from the cloud's viewpoint, each boundary point of the mesh tells which: the
+// incidence of the beam on the surface there, its range, and whether the beam just
+// beyond it met another sample of the scene nearer the scanner. A corner whose
 // neighbouring boundary is mostly where the scan stopped was never reached, and the
 // point the edges meet there is not the sail's corner.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
+#include <unordered_map>
 
 #include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
@@ -16,24 +20,80 @@
 namespace sailshape::outline_internal {
 namespace {
 
-enum class Stop { Edge, Grazing, Range };
+enum class Stop { Edge, Grazing, Range, Shadow };
 
 struct BoundaryStop {
   Stop stop = Stop::Edge;
   double incidence_deg = 0;
   double range_m = 0;
+  double shadow_range_m = 0;  // how far from the scanner the nearest thing in the way stands (Shadow)
+  // Edge beside a narrow shadow: the sail's edge lies between the boundary and this far
+  // beyond it, where the beams pass the thing in the way again and meet nothing of the
+  // sail (0: no shadow), m.
+  double bracket_m = 0;
+};
+
+// The scene as the scanner saw it: each point's direction from the scanner on a grid
+// of unit vectors `cell` radians wide, and the nearest range in each cell. A beam
+// towards direction u met nothing nearer than nearest(u) (within a cell each way).
+class DirectionMap {
+ public:
+  DirectionMap(const std::vector<Vec3>& points, const Vec3& scanner, double cell) : scanner_(scanner), cell_(cell) {
+    for (const Vec3& p : points) {
+      const Vec3 d = p - scanner;
+      const double r = d.norm();
+      if (r <= 0) continue;
+      auto [it, fresh] = nearest_.try_emplace(key(d / r), r);
+      if (!fresh) it->second = std::min(it->second, r);
+    }
+  }
+  // The nearest range among the cells around direction u (unit), or +∞.
+  double nearest(const Vec3& u) const {
+    double best = std::numeric_limits<double>::infinity();
+    const Eigen::Vector3i c = index(u);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          auto it = nearest_.find(pack(c + Eigen::Vector3i(dx, dy, dz)));
+          if (it != nearest_.end()) best = std::min(best, it->second);
+        }
+    return best;
+  }
+
+ private:
+  Eigen::Vector3i index(const Vec3& u) const {
+    return Eigen::Vector3i(static_cast<int>(std::floor(u.x() / cell_)), static_cast<int>(std::floor(u.y() / cell_)),
+                           static_cast<int>(std::floor(u.z() / cell_)));
+  }
+  static uint64_t pack(const Eigen::Vector3i& i) {
+    auto part = [](int v) { return static_cast<uint64_t>(static_cast<uint32_t>(v + (1 << 20)) & 0x1fffff); };
+    return part(i.x()) | part(i.y()) << 21 | part(i.z()) << 42;
+  }
+  uint64_t key(const Vec3& u) const { return pack(index(u)); }
+
+  Vec3 scanner_;
+  double cell_;
+  std::unordered_map<uint64_t, double> nearest_;
 };
 
 // Each loop point's incidence and range from the scanner, and why the samples stop there.
 // The surface normal is the mean of the vertex normals over the two loop points each
 // side (a boundary vertex's own normal rests on one or two triangles).
 std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples& samples, const Vec3& scanner,
-                                         const OutlineParams& p) {
+                                         const std::vector<Vec3>& scene, double around, const OutlineParams& p) {
   const size_t n = loop.size();
   std::vector<BoundaryStop> stops(n);
   // The next sample out lies a boundary spacing further; ranges carry up to 0.3 % of
   // systematic error (SPEC §3).
   const double range_margin = 2.0 * loop.spacing + 0.003 * p.scanner_max_range_m;
+  // The beams' angular spacing: the boundary's sample spacing over its range. The
+  // scene's samples stand on the same grid of directions, so a beam just beyond the
+  // boundary that met something nearer has a scene sample within a cell or two of it.
+  std::vector<double> angular;
+  for (size_t i = 0; i < n; ++i) angular.push_back(loop.spacing / std::max(1e-9, (loop.points[i] - scanner).norm()));
+  std::nth_element(angular.begin(), angular.begin() + static_cast<long>(n / 2), angular.end());
+  const double cell = std::max(1e-5, angular[n / 2]);
+  const DirectionMap seen(scene, scanner, cell);
   for (size_t i = 0; i < n; ++i) {
     Vec3 normal = Vec3::Zero();
     const Vec3 ref = samples.normals[loop.vertex[i]];
@@ -48,6 +108,33 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
     s.incidence_deg = std::acos(std::min(1.0, cosine)) * kDegPerRad;
     if (p.scanner_max_range_m > 0 && s.range_m >= p.scanner_max_range_m - range_margin) s.stop = Stop::Range;
     else if (s.incidence_deg >= p.grazing_incidence_deg) s.stop = Stop::Grazing;
+    if (s.stop != Stop::Edge || scene.empty()) continue;
+    // Two spacings beyond the boundary, outwards across it on the surface: the beam
+    // there met something standing clear of the sail (ten spacings nearer the scanner,
+    // beyond the sail's own samples around it) — a spar, a stay, another sail.
+    const Vec3 tangent = loop.points[(i + 1) % n] - loop.points[(i + n - 1) % n];
+    Vec3 out = tangent.cross(normal.dot(loop.normal) < 0 ? Vec3(-normal) : normal);
+    if (out.norm() < 1e-12) continue;
+    out.normalize();
+    auto blocked = [&](double beyond_m, double& in_the_way) {
+      const Vec3 to = loop.points[i] + beyond_m * out - scanner;
+      in_the_way = seen.nearest(to.normalized());
+      return in_the_way < to.norm() - 10.0 * loop.spacing;
+    };
+    double in_the_way = 0;
+    if (!blocked(2.0 * loop.spacing, in_the_way)) continue;
+    // A narrow shadow (a stay, a mast seen beside a sail's head) ends within the corner's
+    // neighbourhood: beyond it the beams meet nothing nearer, and no sail either (the
+    // boundary would run there otherwise), so the edge lies within the shadow's width.
+    s.stop = Stop::Shadow;
+    s.shadow_range_m = in_the_way;
+    double unused = 0;
+    for (double w = 3.0 * loop.spacing; w <= around; w += loop.spacing)
+      if (!blocked(w, unused)) {
+        s.stop = Stop::Edge;
+        s.bracket_m = w;
+        break;
+      }
   }
   return stops;
 }
@@ -81,22 +168,31 @@ double edgeFraction(const std::vector<BoundaryStop>& stops, const std::vector<si
 // Whether the samples reach the corner at loop index c: the boundary within `around`
 // of it, on each side, is mostly where the sail ends. When not, the reason.
 std::optional<std::string> notReached(const BoundaryLoop& loop, const std::vector<BoundaryStop>& stops, size_t c,
-                                      double around, const char* name, const OutlineParams& p) {
+                                      double around, const char* name, const OutlineParams& p, double& bracket_m) {
   const size_t n = loop.size();
+  bracket_m = 0;
   for (size_t dir : {size_t{1}, n - 1}) {
-    size_t grazing = 0, range = 0, count = 0;
-    double widest_deg = 0, farthest_m = 0;
+    size_t grazing = 0, range = 0, shadow = 0, count = 0;
+    double widest_deg = 0, farthest_m = 0, shadow_m = 0;
     for (size_t i = c, walked = 0; walked <= n / 2; i = (i + dir) % n, ++walked) {
       const double arc = std::abs(loop.cum[i] - loop.cum[c]);
       if (std::min(arc, loop.total - arc) > around) break;
       ++count;
       grazing += stops[i].stop == Stop::Grazing;
       range += stops[i].stop == Stop::Range;
+      if (stops[i].stop == Stop::Shadow) {
+        ++shadow;
+        shadow_m = std::max(shadow_m, stops[i].shadow_range_m);
+      }
       widest_deg = std::max(widest_deg, stops[i].incidence_deg);
+      bracket_m = std::max(bracket_m, stops[i].bracket_m);
       farthest_m = std::max(farthest_m, stops[i].range_m);
     }
-    if (2 * (grazing + range) <= count) continue;
+    if (2 * (grazing + range + shadow) <= count) continue;
     const std::string at = std::string("the ") + name + ": the samples stop ";
+    if (shadow >= grazing && shadow >= range)
+      return at + "at the shadow of something " + formatFixed(shadow_m, 1) +
+             " m from the scanner, between it and the sail";
     if (range >= grazing)
       return at + formatFixed(farthest_m, 1) + " m from the scanner, at the end of its " +
              formatFixed(p.scanner_max_range_m, 0) + " m range";
@@ -109,26 +205,26 @@ std::optional<std::string> notReached(const BoundaryLoop& loop, const std::vecto
 }  // namespace
 
 SailOutline::Coverage scanCoverage(const BoundaryLoop& loop, const NamedCorners& c, const Samples& samples,
-                                   const Vec3& scanner, const OutlineParams& p) {
+                                   const Vec3& scanner, const std::vector<Vec3>& scene, const OutlineParams& p) {
   SailOutline::Coverage cov;
   cov.known = true;
-  const std::vector<BoundaryStop> stops = stopsAlongLoop(loop, samples, scanner, p);
+  // A corner's neighbourhood: the stretch of boundary its turn is measured over.
+  const double around = std::max(5.0 * loop.spacing, 0.02 * loop.total);
+  const std::vector<BoundaryStop> stops = stopsAlongLoop(loop, samples, scanner, scene, around, p);
   cov.luff = edgeFraction(stops, indicesBetween(loop, c, c.tack, c.head));
   cov.foot = edgeFraction(stops, indicesBetween(loop, c, c.tack, c.clew));
   cov.leech = edgeFraction(stops, indicesBetween(loop, c, c.clew, c.has_peak ? c.peak : c.head));
   if (c.has_peak) cov.top = edgeFraction(stops, indicesBetween(loop, c, c.head, c.peak));
-  // A corner's neighbourhood: the stretch of boundary its turn is measured over.
-  const double around = std::max(5.0 * loop.spacing, 0.02 * loop.total);
-  auto check = [&](size_t corner, const char* name, bool& reached) {
-    if (auto why = notReached(loop, stops, corner, around, name, p)) {
+  auto check = [&](size_t corner, const char* name, bool& reached, double& bracket_m) {
+    if (auto why = notReached(loop, stops, corner, around, name, p, bracket_m)) {
       reached = false;
       cov.unreached.push_back(*why);
     }
   };
-  check(c.tack, "tack", cov.tack);
-  check(c.clew, "clew", cov.clew);
-  check(c.head, "head", cov.head);
-  if (c.has_peak) check(c.peak, "peak", cov.peak);
+  check(c.tack, "tack", cov.tack, cov.tack_shadow_m);
+  check(c.clew, "clew", cov.clew, cov.clew_shadow_m);
+  check(c.head, "head", cov.head, cov.head_shadow_m);
+  if (c.has_peak) check(c.peak, "peak", cov.peak, cov.peak_shadow_m);
   return cov;
 }
 

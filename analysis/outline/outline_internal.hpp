@@ -227,10 +227,12 @@ double moveOutByFootprint(std::vector<Vec3>& line, double& sigma, const OutlineP
 // ---- coverage.cpp: where the samples stop, and why ----
 
 // Whether the scan reached each corner and each edge (SailOutline::Coverage), from
-// where the scanner stood: a boundary the beams met at grazing incidence, or at the
-// end of their range, is where the scan stopped, not where the sail ends.
+// where the scanner stood: a boundary the beams met at grazing incidence, at the end
+// of their range, or beyond which they met something else of the `scene` first (its
+// points as scanned, the sail's among them; empty: not looked for), is where the scan
+// stopped, not where the sail ends.
 SailOutline::Coverage scanCoverage(const BoundaryLoop& loop, const NamedCorners& corners, const Samples& samples,
-                                   const Vec3& scanner, const OutlineParams& params);
+                                   const Vec3& scanner, const std::vector<Vec3>& scene, const OutlineParams& params);
 
 // ---- consistency.cpp: whether the outline is a sail's ----
 

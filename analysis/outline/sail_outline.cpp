@@ -77,6 +77,23 @@ CornerSpreads placeCorners(const SailEdges& e, const CornerContext& ctx, SailOut
   return at;
 }
 
+// A corner beside a narrow shadow lies anywhere across the shadow's width w from
+// where its samples stop: uniform, σ = w / √12 joins its place along the bisector.
+void widenForShadows(SailOutline& out, CornerSpreads& at) {
+  const SailOutline::Coverage& c = out.coverage;
+  auto widen = [](double shadow_m, CornerSpread& spread, double& sigma, double& position) {
+    if (shadow_m <= 0) return;
+    spread.along_m = std::hypot(spread.along_m, shadow_m / std::sqrt(12.0));
+    sigma = spread.along_m;
+    position = spread.position();
+  };
+  SailOutline::Uncertainty& u = out.uncertainty;
+  widen(c.tack_shadow_m, at.tack, out.tack_sigma_m, u.tack_m);
+  widen(c.clew_shadow_m, at.clew, out.clew_sigma_m, u.clew_m);
+  widen(c.head_shadow_m, at.head, out.head_sigma_m, u.head_m);
+  if (out.has_peak) widen(c.peak_shadow_m, at.peak, out.peak_sigma_m, u.peak_m);
+}
+
 void warnOfScanLines(const SailEdges& e, SailOutline& out) {
   for (const auto& [name, edge] : {std::pair<const char*, const Edge*>{"luff", &e.luff}, {"leech", &e.leech},
                                    {"foot", &e.foot}, {"top edge", &e.top}})
@@ -195,7 +212,8 @@ void checkOutlineParams(const OutlineParams& p) {
 }
 
 SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::vector<Vec3>& loose_points,
-                           double sample_density_per_m2, const std::optional<Vec3>& scanner) {
+                           double sample_density_per_m2, const std::optional<Vec3>& scanner,
+                           const std::vector<Vec3>& scene) {
   if (mesh.triangles.empty()) throw InvalidInput("[extractOutline] empty mesh");
   checkOutlineParams(p);
   SailOutline out;
@@ -221,7 +239,7 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
   // Cells about three boundary spacings wide: the 24 nearest vertices of a boundary point lie within two or so.
   const PointGrid tree(mesh.vertices, 3.0 * std::max(sp, 1e-6));
   const Samples samples{mesh, normals, tree};
-  if (scanner) out.coverage = scanCoverage(loop, corners, samples, *scanner, p);
+  if (scanner) out.coverage = scanCoverage(loop, corners, samples, *scanner, scene, p);
   const SailEdges edges = fitEdges(loop, corners, samples);
   setEdgeSigmas(edges, out);
 
@@ -231,7 +249,8 @@ SailOutline extractOutline(const Mesh& mesh, const OutlineParams& p, const std::
                              : static_cast<double>(mesh.vertices.size()) / std::max(1e-12, mesh_area);
   const CornerContext ctx{samples, loose_points, density, std::max(0.05 * loop.total, 10.0 * sp), sp, p,
                           footprint_scanner};
-  const CornerSpreads spreads = placeCorners(edges, ctx, out);
+  CornerSpreads spreads = placeCorners(edges, ctx, out);
+  widenForShadows(out, spreads);
   warnOfScanLines(edges, out);
   traceEdges(edges, p, footprint_scanner, samples, sp, out);
   out.area_m2 = mesh_area + areaBeyondMesh(loop, corners, out);

@@ -93,6 +93,9 @@ struct SailOutline {
     // Each corner reached: the boundary beside it is where the sail ends, not where
     // the beams grazed the cloth or ran out of range.
     bool tack = true, clew = true, head = true, peak = true;
+    // The width of a narrow shadow beside a reached corner (a mast or stay in the way
+    // of its edges), which the sail's edge lies within; its σ carries it, m (0: none).
+    double tack_shadow_m = 0, clew_shadow_m = 0, head_shadow_m = 0, peak_shadow_m = 0;
     // The fraction of each edge's sampled boundary where the sail ends (the rest is
     // where the scan stopped), in [0, 1].
     double luff = 1, leech = 1, foot = 1, top = 1;
@@ -116,9 +119,12 @@ void checkOutlineParams(const OutlineParams& params);
 // taken at, when the loose points are the scan's own and the mesh's vertices are
 // fewer (voxel means); 0: the mesh's vertices per square metre. `scanner`: where the
 // samples were measured from (the beam footprint correction needs it).
+// `scene`: every sample the scanner took (the sail's among them), in the mesh's frame: a
+// boundary beyond which the beams met one of them first is the shadow of what stood in
+// the way, not the sail's edge (SailOutline::coverage; empty: shadows are not looked for).
 SailOutline extractOutline(const Mesh& mesh, const OutlineParams& params = {},
                            const std::vector<Vec3>& loose_points = {}, double sample_density_per_m2 = 0,
-                           const std::optional<Vec3>& scanner = std::nullopt);
+                           const std::optional<Vec3>& scanner = std::nullopt, const std::vector<Vec3>& scene = {});
 
 // Length of a polyline, m.
 double polylineLength(const std::vector<Vec3>& line);

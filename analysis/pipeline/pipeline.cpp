@@ -408,7 +408,7 @@ void meshSurface(const Cloud& cloud, const AnalysisParams& p, const Progress& pr
 // The outline stage: a.outline and a.luff from a.mesh, the corners read from the
 // `loose` points too. `sail_scan`: the sail's own samples when the sweep lost lines.
 void outlineSail(const Cloud& input, const Cloud& sail_scan, const std::vector<Vec3>& scan_points,
-                 const AnalysisParams& p, SailAnalysis& a, std::vector<Vec3>& loose) {
+                 const std::vector<Vec3>& scene, const AnalysisParams& p, SailAnalysis& a, std::vector<Vec3>& loose) {
   StageTimer t(a, "outline", a.mesh.vertices.size());
   // A column mean at a narrow tip lies up to half a column short of the tip's outermost
   // samples: the corners read the scan's own points, at the scan's density.
@@ -417,7 +417,7 @@ void outlineSail(const Cloud& input, const Cloud& sail_scan, const std::vector<V
     loose.insert(loose.end(), scan_points.begin(), scan_points.end());
     sample_density = static_cast<double>(a.sail_points) / std::max(1e-12, meshArea(a.mesh));
   }
-  a.outline = extractOutline(a.mesh, p.outline, loose, sample_density, input.viewpoint);
+  a.outline = extractOutline(a.mesh, p.outline, loose, sample_density, input.viewpoint, scene);
   for (std::string& w : widenCornersBesideLostLines(a.outline, sail_scan)) a.outline.warnings.push_back(std::move(w));
   a.luff = measureLuffCurve(a.outline);
   t.finish(a.outline.boundary.size(), a.outline.warnings);
@@ -478,6 +478,9 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     cloud = selectPoints(cloud, c.kept);
     t.finish(cloud.size(), c.warnings);
   }
+  // What the scanner saw, for the shadows things in the way cast on the sail.
+  std::vector<Vec3> scene;
+  if (input.viewpoint) scene = cloud.points;
   if (p.segment) segmentSail(cloud, p, progress, a);
 
   // The sail's own samples, with their scan angles, when the sweep lost lines: a
@@ -499,7 +502,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), s.warnings);
   }
   meshSurface(cloud, p, progress, a, loose);
-  outlineSail(input, sail_scan, working.scan_points, p, a, loose);
+  outlineSail(input, sail_scan, working.scan_points, scene, p, a, loose);
   measureSections(p, a);
   refuseImplausibleResults(a);
   progress("done", 1.0);

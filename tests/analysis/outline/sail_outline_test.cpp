@@ -262,6 +262,45 @@ TEST(SailOutline, ATopBeyondTheScannersRangeLeavesTheHeadUnreached) {
   EXPECT_TRUE(extractOutline(cut, p, {}, 0, scanner).coverage.head);
 }
 
+// A board halfway between the scanner and the main hides its top: the samples stop
+// along the board's shadow, 10 m up. Told what the scanner saw (the board's samples
+// among the sail's), that boundary is the shadow's and the head was not reached;
+// told nothing of the scene, the same samples read as a sail ending there.
+TEST(SailOutline, ATopInTheShadowOfABoardLeavesTheHeadUnreached) {
+  const Vec3 scanner(-1.5, -8, 5);
+  // The board: y = -4, x from -4 to 1.5, z from 7.5 to 9; its shadow on y = 0 starts at z = 10.
+  std::vector<Vec3> scene;
+  for (double x = -4; x <= 1.5; x += 0.01)
+    for (double z = 7.5; z <= 9; z += 0.01) scene.emplace_back(x, -4, z);
+  const Mesh full = flatTriangle(kTack, kClew, kHead);
+  const Mesh lit = keepTriangles(full, [&](const Vec3& p) {
+    const double t = (-4 - scanner.y()) / (p.y() - scanner.y());  // where the beam to p crosses y = -4
+    const Vec3 at = scanner + t * (p - scanner);
+    return !(at.x() >= -4 && at.x() <= 1.5 && at.z() >= 7.5 && at.z() <= 9);
+  });
+  for (const Vec3& v : lit.vertices) scene.push_back(v);
+  const SailOutline o = extractOutline(lit, {}, {}, 0, scanner, scene);
+  EXPECT_FALSE(o.coverage.head);
+  EXPECT_TRUE(o.coverage.tack && o.coverage.clew);
+  ASSERT_FALSE(o.coverage.unreached.empty());
+  // The board stands 4.7 m (its nearest edge) to 5.9 m (its far corners) from the scanner.
+  const std::string shadow = "samples stop at the shadow of something ";
+  for (const std::string& why : o.coverage.unreached) {
+    const size_t at = why.find(shadow);
+    ASSERT_NE(at, std::string::npos) << why;
+    const double range_m = std::stod(why.substr(at + shadow.size()));
+    EXPECT_GE(range_m, 4.65) << why;
+    EXPECT_LE(range_m, 5.95) << why;
+  }
+  EXPECT_TRUE(extractOutline(lit, {}, {}, 0, scanner).coverage.allCornersReached());
+  // The whole main, the board beside it and casting its shadow on nothing: every corner reached.
+  std::vector<Vec3> beside;
+  for (double x = 3; x <= 5; x += 0.01)
+    for (double z = 7.5; z <= 9; z += 0.01) beside.emplace_back(x, -4, z);
+  for (const Vec3& v : full.vertices) beside.push_back(v);
+  EXPECT_TRUE(extractOutline(full, {}, {}, 0, scanner, beside).coverage.allCornersReached());
+}
+
 TEST(SailOutline, AClosedSurfaceHasNoBoundary) {
   Mesh m;
   m.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
