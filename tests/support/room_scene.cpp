@@ -1,0 +1,149 @@
+#include "tests/support/room_scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include "analysis/core/errors.hpp"
+#include "analysis/core/units.hpp"
+
+namespace sailshape {
+
+Cloud sweepUnit(const EmulatedSensor& sensor, const RigidTransform& pose, const RoomSceneParams& p, uint64_t seed) {
+  const ScannerSpec& spec = sensor.spec();
+  const double a_step = p.alpha_step_deg * kRadPerDeg;
+  const double first = std::max(spec.first_angle_deg, p.alpha_first_deg);
+  const double last = std::min(spec.last_angle_deg, p.alpha_last_deg);
+  if (!(last > first)) throw InvalidInput("[makeRoomScene] the mirror window leaves no beam in the field of view");
+  const double a0 = first * kRadPerDeg;
+  const size_t count = static_cast<size_t>(std::floor((last - first) / p.alpha_step_deg)) + 1;
+  const Eigen::Matrix3d rot = pose.linear();
+  Cloud cloud;
+  cloud.viewpoint = Vec3::Zero();
+  const int lines = static_cast<int>(std::floor(p.beta_span_deg / p.beta_step_deg)) + 1;
+  for (int k = 0; k < lines; ++k) {
+    const double beta = (-p.beta_span_deg / 2 + k * p.beta_step_deg) * kRadPerDeg;
+    // Unit frame: the mirror plane holds +X (α = 0) and (0, cos β, sin β) (α = 90°).
+    const Vec3 ux = Vec3::UnitX(), uy(0, std::cos(beta), std::sin(beta));
+    ScanLineRequest r;
+    r.origin = pose.translation();
+    r.axis_x = rot * ux;
+    r.axis_y = rot * uy;
+    r.start_rad = a0;
+    r.step_rad = a_step;
+    r.count = count;
+    r.seed = seed * 1'000'003u + static_cast<uint64_t>(k);
+    const std::vector<BeamReturn> line = sensor.scanLine(r);
+    for (size_t i = 0; i < line.size(); ++i) {
+      if (line[i].status != ReturnStatus::Valid || line[i].range_m > p.max_range_m) continue;
+      const double alpha = a0 + a_step * static_cast<double>(i);
+      cloud.points.push_back(line[i].range_m * (std::cos(alpha) * ux + std::sin(alpha) * uy));
+      cloud.alpha_rad.push_back(alpha);
+      cloud.beta_rad.push_back(beta);
+      cloud.intensity.push_back(line[i].rssi);
+    }
+  }
+  return cloud;
+}
+
+RoomScene makeRoomScene(const RoomSceneParams& p) {
+  if (!(p.alpha_step_deg > 0) || !(p.beta_step_deg > 0) || !(p.beta_span_deg > 0))
+    throw InvalidInput("[makeRoomScene] alpha_step_deg, beta_step_deg and beta_span_deg must be > 0");
+  RoomScene out;
+  out.scene.name = p.deck ? "deck" : "room";
+  if (p.deck) {
+    const Vec3 c = (p.room_min + p.room_max) / 2, h = p.room_max - p.room_min;
+    const double z = p.room_min.z();
+    out.scene.objects.push_back({"floor", Material::Paint,
+                                 makeQuad(Vec3(c.x() - h.x(), c.y() - h.y(), z), Vec3(c.x() + h.x(), c.y() - h.y(), z),
+                                          Vec3(c.x() + h.x(), c.y() + h.y(), z), Vec3(c.x() - h.x(), c.y() + h.y(), z))});
+  } else {
+    out.scene.objects = makeChamber(p.room_min, p.room_max);
+  }
+  if (p.cube_centre) {
+    const double s = p.cube_size_m / 2;
+    Mesh cube = makeBox(Vec3(-s, -s, -s), Vec3(s, s, s));
+    const Eigen::Matrix3d rz = Eigen::AngleAxisd(p.cube_yaw_deg * kRadPerDeg, Vec3::UnitZ()).toRotationMatrix();
+    for (Vec3& v : cube.vertices) v = rz * v + *p.cube_centre;
+    out.scene.objects.push_back({"cube", Material::LightGrey, cube});
+  }
+  if (p.mast_foot) out.scene.objects.push_back({"mast", Material::Metal, makeCylinder(*p.mast_foot, Vec3::UnitZ(), 0.05, 3.0, 24)});
+  SensorModelParams sp;
+  sp.model = p.model;
+  sp.noise_scale = p.noise_scale;
+  sp.systematic_fraction = p.reference_systematic_fraction;
+  const EmulatedSensor ref_sensor(out.scene, sp);
+  sp.systematic_fraction = p.moving_systematic_fraction;
+  const EmulatedSensor mov_sensor(out.scene, sp);
+  out.reference = sweepUnit(ref_sensor, p.reference_pose, p, p.seed);
+  out.moving = sweepUnit(mov_sensor, p.moving_pose, p, p.seed + 7919);
+  out.truth = p.reference_pose.inverse() * p.moving_pose;
+  return out;
+}
+
+}  // namespace sailshape
+
+namespace sailshape {
+
+RandomCase randomRegistrationCase(uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  auto uni = [&](double a, double b) { return a + (b - a) * U(rng); };
+  RandomCase c;
+  RoomSceneParams& p = c.params;
+  p.seed = seed;
+  p.alpha_step_deg = p.beta_step_deg = 1.0;
+  p.deck = U(rng) < 0.2;
+  const double ly = uni(2.6, 4.2);
+  const double lz = U(rng) < 0.3 ? ly : uni(2.2, 3.2);  // a square cross-section: 90° turns fit the walls too
+  const double lx = uni(4.5, 8.0);
+  p.room_min = Vec3(-lx / 2, -ly / 2, 0);
+  p.room_max = Vec3(lx / 2, ly / 2, lz);
+  const bool cube = p.deck || U(rng) < 0.85;
+  p.cube_size_m = uni(0.5, 0.6);
+  if (cube) p.cube_centre = Vec3(uni(-lx / 2 + 0.8, lx / 2 - 0.8), uni(-ly / 2 + 0.7, ly / 2 - 0.7), p.cube_size_m / 2);
+  else p.cube_centre.reset();
+  p.cube_yaw_deg = uni(0, 90);
+  if (p.deck) p.mast_foot = Vec3(uni(-1, 1), uni(-0.5, 0.5), 0);
+  // Unit origins inside, clear of the walls, the cube and each other; any orientation.
+  auto origin = [&] {
+    for (;;) {
+      const Vec3 o(uni(-lx / 2 + 0.5, lx / 2 - 0.5), uni(-ly / 2 + 0.5, ly / 2 - 0.5), uni(0.8, lz - 0.5));
+      if (p.cube_centre && (o - *p.cube_centre).norm() < 1.0) continue;
+      if (p.mast_foot && std::hypot(o.x() - p.mast_foot->x(), o.y() - p.mast_foot->y()) < 0.5) continue;
+      return o;
+    }
+  };
+  auto rotation = [&] {
+    const Eigen::Quaterniond q(uni(-1, 1), uni(-1, 1), uni(-1, 1), uni(-1, 1));
+    return q.normalized().toRotationMatrix();
+  };
+  p.reference_pose = RigidTransform::Identity();
+  p.reference_pose.linear() = rotation();
+  p.reference_pose.translation() = origin();
+  p.moving_pose = RigidTransform::Identity();
+  p.moving_pose.linear() = rotation();
+  do p.moving_pose.translation() = origin();
+  while ((p.moving_pose.translation() - p.reference_pose.translation()).norm() < 1.0);
+  // Partial views: a mirror window of 180–270° and a sweep of 120–180°.
+  const double window = uni(180, 270);
+  p.alpha_first_deg = uni(-135, 135 - window);
+  p.alpha_last_deg = p.alpha_first_deg + window;
+  p.beta_span_deg = uni(120, 180);
+  p.noise_scale = U(rng) < 0.25 ? 0.0 : uni(0.5, 1.6);
+  const bool systematic = U(rng) < 0.33;
+  if (systematic) {
+    p.reference_systematic_fraction = uni(0, 0.003);
+    p.moving_systematic_fraction = uni(0, 0.003);
+  }
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%s %.1f×%.1f×%.1f m, %s, noise ×%.2f, range error %.2f/%.2f %%",
+                p.deck ? "deck" : "room", lx, ly, lz, cube ? "cube" : "no cube", p.noise_scale,
+                100 * p.reference_systematic_fraction, 100 * p.moving_systematic_fraction);
+  c.label = buf;
+  return c;
+}
+
+}  // namespace sailshape
