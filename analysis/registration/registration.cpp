@@ -1,8 +1,11 @@
 #include "analysis/registration/registration.hpp"
 
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "analysis/core/errors.hpp"
@@ -302,47 +305,65 @@ std::vector<Candidate> matchPlaneSets(const PlaneSets& sets, const std::vector<D
   return candidates;
 }
 
-// The best candidate's diagnostics into `out`: its overlap, its plane pairings,
-// and whether another candidate does about as well (an ambiguous match).
-// `candidates` are sorted best first.
-void reportPlaneMatch(const std::vector<Candidate>& candidates, const std::vector<DetectedPlane>& R,
-                      const std::vector<DetectedPlane>& M, const PlaneMatchParams& m, size_t need, size_t samples,
-                      Registration& out) {
-  const Candidate& best = candidates.front();
-  out.candidates = candidates.size();
-  out.coarse_overlap_fraction = static_cast<double>(best.score) / static_cast<double>(samples);
-  out.coarse_planes_on = best.planes_on;
-  for (size_t x = 0; x < need; ++x) {
-    PlanePairing pp;
-    pp.reference_plane = best.ref[x];
-    pp.moving_plane = best.mov[x];
-    pp.reference_normal = R[best.ref[x]].normal;
-    pp.moving_normal = M[best.mov[x]].normal;
-    pp.reference_points = R[best.ref[x]].points;
-    pp.moving_points = M[best.mov[x]].points;
-    out.pairings.push_back(pp);
+// The pose that lays every landed moving plane (on[k]: its reference plane,
+// R.size(): none) on its reference plane in the weighted least-squares sense:
+// the rotation from all normal pairs (Kabsch, each weighted by points × extent²,
+// the inverse variance of a fitted normal), the translation from all offsets
+// (n_r·t = d_r − d_m, weighted by points, the inverse variance of a fitted
+// offset). What the landed planes leave free (a rotation about one normal, a
+// translation along the planes) stays as in `start`.
+RigidTransform jointPlanePose(const RigidTransform& start, const std::vector<size_t>& on,
+                              const std::vector<DetectedPlane>& R, const std::vector<DetectedPlane>& M,
+                              const PlaneIndependence& independent) {
+  std::vector<size_t> landed;
+  for (size_t k = 0; k < M.size(); ++k)
+    if (on[k] < R.size()) landed.push_back(k);
+  bool turns = false;
+  for (size_t a = 0; a < landed.size() && !turns; ++a)
+    for (size_t b = a + 1; b < landed.size() && !turns; ++b) turns = independent.pair(M[landed[a]].normal, M[landed[b]].normal);
+  RigidTransform t = start;
+  auto pairWeight = [](double wr, double wm) { return wr > 0 && wm > 0 ? 1.0 / (1.0 / wr + 1.0 / wm) : 0.0; };
+  if (turns) {
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    for (size_t k : landed) {
+      const DetectedPlane &r = R[on[k]], &m = M[k];
+      const double w = pairWeight(static_cast<double>(r.points) * r.extent_m * r.extent_m,
+                                  static_cast<double>(m.points) * m.extent_m * m.extent_m);
+      h += w * m.normal * r.normal.transpose();
+    }
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    t.linear() = svd.matrixV() * d * svd.matrixU().transpose();
   }
-  for (size_t i = 1; i < candidates.size(); ++i) {
-    if (candidates[i].planes_on < best.planes_on ||
-        static_cast<double>(candidates[i].score) < m.ambiguity_ratio * static_cast<double>(best.score))
-      break;
-    out.ambiguous = true;
-    out.warnings.push_back("ambiguous plane match: another alignment " +
-                           formatFixed(rotationDifferenceDeg(best.transform.linear(), candidates[i].transform.linear()), 1) +
-                           "° and " + formatFixed((best.transform.translation() - candidates[i].transform.translation()).norm()) +
-                           " m away puts as many planes (" + std::to_string(best.planes_on) + ") and " +
-                           std::to_string(candidates[i].score) + " sampled points (best " + std::to_string(best.score) +
-                           ") on the reference; give plane hints or a picked pair");
-    break;
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Vec3 b = Vec3::Zero();
+  for (size_t k : landed) {
+    const DetectedPlane &r = R[on[k]], &m = M[k];
+    const double w = pairWeight(static_cast<double>(r.points), static_cast<double>(m.points));
+    a += w * r.normal * r.normal.transpose();
+    b += w * r.normal * (r.offset_m - m.offset_m);
   }
+  // A vanishing pull towards the start's translation fixes the unconstrained directions.
+  const double lambda = 1e-9 * std::max(a.trace(), 1.0);
+  t.translation() = (a + lambda * Eigen::Matrix3d::Identity()).ldlt().solve(b + lambda * start.translation());
+  return t;
 }
 
-// The study's coarse alignment from matched planes, chosen among every
-// consistent match by how many moving points it brings near the reference.
-RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
-                              const Progress& progress, Registration& out, std::vector<PlaneAnchor>& anchors) {
-  const PlaneDetection dr = detectPlanes(reference, p.planes, progress);
-  const PlaneDetection dm = detectPlanes(moving, p.planes, progress);
+// One pose the planes allow, with the moving planes it lands (ICP anchors).
+struct Hypothesis {
+  Candidate candidate;  // the plane set it came from; transform: solved from every landed plane
+  std::vector<size_t> on;
+  PoseEvidence screen;
+};
+
+// Every distinct pose the matched planes allow, each solved jointly from all the
+// planes it lands; `out` gets the plane counts.
+std::vector<Hypothesis> planeHypotheses(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
+                                        const Progress& progress, Registration& out, PlaneDetection& dr,
+                                        PlaneDetection& dm) {
+  dr = detectPlanes(reference, p.planes, progress);
+  dm = detectPlanes(moving, p.planes, progress);
   for (const auto& w : dr.warnings) out.warnings.push_back("reference planes: " + w);
   for (const auto& w : dm.warnings) out.warnings.push_back("moving planes: " + w);
   out.reference_planes = dr.planes.size();
@@ -364,10 +385,9 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
   const auto& R = dr.planes;
   const auto& M = dm.planes;
   const PlaneSets sets = planeSets(reference, moving, dr, dm, p, independent, need, need_text);
-
   CandidateScorer scorer(reference, moving, R, M, m);
   bool any_moving_set = false;
-  std::vector<Candidate> candidates =
+  const std::vector<Candidate> candidates =
       matchPlaneSets(sets, R, M, p, independent, need, scorer, progress, any_moving_set);
   if (candidates.empty())
     throw AnalysisError(std::string("[registerClouds] no ") + (need == 3 ? "three" : "two") +
@@ -376,22 +396,56 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
                         (any_moving_set ? "the third normal disagreed" : "no consistent set") +
                         "; reference: " + describePlanes(R) + "; moving: " + describePlanes(M) +
                         ") — give plane hints or picked pairs");
-  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
-    return a.planes_on != b.planes_on ? a.planes_on > b.planes_on : a.score > b.score;
-  });
-  reportPlaneMatch(candidates, R, M, m, need, scorer.samples(), out);
-  const Candidate& best = candidates.front();
-  // Every moving plane that lands on a reference plane anchors the refinement.
-  const std::vector<size_t> on = scorer.landings(best.transform);
+  out.candidates = candidates.size();
+  std::vector<Hypothesis> hyps;
+  for (const Candidate& c : candidates) {
+    Hypothesis h;
+    h.candidate = c;
+    // With a picked pair the translation is the pair's; the planes only turn.
+    RigidTransform t = c.transform;
+    for (int pass = 0; pass < 2 && !pair_translation; ++pass) t = jointPlanePose(t, scorer.landings(t), R, M, independent);
+    h.candidate.transform = t;
+    h.on = scorer.landings(t);
+    h.candidate.planes_on = 0;
+    for (size_t j : h.on) h.candidate.planes_on += j < R.size();
+    bool seen = false;
+    for (const Hypothesis& o : hyps)
+      seen = seen || (rotationDifferenceDeg(o.candidate.transform.linear(), t.linear()) < 1.0 &&
+                      (o.candidate.transform.translation() - t.translation()).norm() < m.verify_radius_m);
+    if (!seen) hyps.push_back(std::move(h));
+  }
+  return hyps;
+}
+
+void reportPairings(const Hypothesis& h, const std::vector<DetectedPlane>& R, const std::vector<DetectedPlane>& M,
+                    Registration& out) {
+  out.coarse_planes_on = h.candidate.planes_on;
+  out.pairings.clear();
   for (size_t k = 0; k < M.size(); ++k) {
-    if (on[k] == R.size()) continue;
+    if (h.on[k] >= R.size()) continue;
+    PlanePairing pp;
+    pp.reference_plane = h.on[k];
+    pp.moving_plane = k;
+    pp.reference_normal = R[h.on[k]].normal;
+    pp.moving_normal = M[k].normal;
+    pp.reference_points = R[h.on[k]].points;
+    pp.moving_points = M[k].points;
+    out.pairings.push_back(pp);
+  }
+}
+
+std::vector<PlaneAnchor> planeAnchors(const Cloud& moving, const Hypothesis& h, const std::vector<DetectedPlane>& R,
+                                      const std::vector<DetectedPlane>& M, size_t max_points) {
+  std::vector<PlaneAnchor> anchors;
+  for (size_t k = 0; k < M.size(); ++k) {
+    if (h.on[k] >= R.size()) continue;
     PlaneAnchor a;
-    a.normal = R[on[k]].normal;
-    a.offset_m = R[on[k]].offset_m;
-    for (uint32_t i : thin(M[k].indices, p.max_anchor_points)) a.moving_points.push_back(moving.points[i]);
+    a.normal = R[h.on[k]].normal;
+    a.offset_m = R[h.on[k]].offset_m;
+    for (uint32_t i : thin(M[k].indices, max_points)) a.moving_points.push_back(moving.points[i]);
     anchors.push_back(std::move(a));
   }
-  return best.transform;
+  return anchors;
 }
 
 // How well the aligned moving cloud lies on the reference surface over their
@@ -431,6 +485,127 @@ SurfaceFit surfaceFit(const Cloud& reference, const Cloud& aligned, double radiu
   return fit;
 }
 
+// ICP from a coarse pose over the crossed overlap (SPEC §4 step 2).
+struct Refinement {
+  RigidTransform transform = RigidTransform::Identity();
+  CrossedFilter overlap;
+  bool enough_overlap = false;
+  int iterations = 0;
+  bool converged = true;
+  std::vector<std::string> warnings;
+};
+
+Refinement refinePose(const Cloud& reference, const Cloud& moving, const RigidTransform& coarse,
+                      const std::vector<PlaneAnchor>& anchors, const RegistrationParams& p, const Progress& progress) {
+  Refinement r;
+  r.transform = coarse;
+  r.overlap = crossedFilter(reference, transformCloud(moving, coarse), p.crossed_radius_m);
+  r.enough_overlap = r.overlap.moving.size() >= p.min_overlap_points && r.overlap.reference.size() >= p.min_overlap_points;
+  if (!r.enough_overlap || !p.refine) return r;
+  const Cloud ref_sub = selectPoints(reference, thin(r.overlap.reference, p.max_icp_points));
+  const Cloud mov_sub = selectPoints(moving, thin(r.overlap.moving, p.max_icp_points));
+  IcpParams ip = p.icp;
+  ip.max_correspondence_m = std::min(ip.max_correspondence_m, p.crossed_radius_m);
+  const IcpResult icp =
+      refineIcp(ref_sub, mov_sub, coarse, ip, progress, ip.method == "point-to-plane" ? anchors : std::vector<PlaneAnchor>{});
+  for (const auto& w : icp.warnings) r.warnings.push_back("refinement: " + w);
+  r.iterations = icp.iterations;
+  r.converged = icp.converged;
+  r.transform = icp.transform;
+  return r;
+}
+
+// A refined plane hypothesis and what the verifier made of it.
+struct Verified {
+  const Hypothesis* hypothesis = nullptr;
+  Refinement refinement;
+  PoseEvidence evidence;
+  bool fits = false;  // on its own it would pass the fitness, inlier and convergence tests
+};
+
+// The plane method: every hypothesis screened by its likelihood on a few
+// samples, the likeliest refined by ICP and scored on all samples both ways;
+// the best must beat the runner-up (a different pose) by the verifier's margin,
+// else the result is ambiguous and says which poses compete and what decides.
+Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
+                           const Progress& progress, Registration& out) {
+  PlaneDetection dr, dm;
+  std::vector<Hypothesis> hyps = planeHypotheses(reference, moving, p, progress, out, dr, dm);
+  const PoseVerifier verifier(reference, moving, p.verify);
+  // Poses closer than the crossed radius everywhere over the moving cloud are one.
+  double extent = 0;
+  const Vec3 centre = moving.viewpoint.value_or(Vec3::Zero());
+  for (const Vec3& q : moving.points) extent = std::max(extent, (q - centre).norm());
+  for (Hypothesis& h : hyps) h.screen = verifier.evaluate(h.candidate.transform, p.screen_samples);
+  std::sort(hyps.begin(), hyps.end(),
+            [](const Hypothesis& a, const Hypothesis& b) { return a.screen.consistency > b.screen.consistency; });
+  std::vector<Verified> refined;
+  for (size_t i = 0; i < hyps.size() && i < p.refined_hypotheses; ++i) {
+    progress("verifying poses", static_cast<double>(i) / static_cast<double>(std::min(hyps.size(), p.refined_hypotheses)));
+    Verified v;
+    v.hypothesis = &hyps[i];
+    v.refinement = refinePose(reference, moving, hyps[i].candidate.transform,
+                              planeAnchors(moving, hyps[i], dr.planes, dm.planes, p.max_anchor_points), p, {});
+    if (!v.refinement.enough_overlap) continue;
+    v.evidence = verifier.evaluate(v.refinement.transform);
+    const SurfaceFit fit = surfaceFit(reference, transformCloud(moving, v.refinement.transform), p.crossed_radius_m,
+                                      p.uncertainty_m, p.icp.normal_k, p.max_icp_points);
+    v.fits = fit.points > 0 && fit.rms_m <= p.uncertainty_m && fit.inlier_fraction >= p.min_inlier_fraction &&
+             v.refinement.converged;
+    // Two hypotheses ICP brought to one pose are one pose.
+    bool same = false;
+    for (Verified& o : refined) {
+      if (compareTransforms(o.refinement.transform, v.refinement.transform, extent, p.crossed_radius_m).moved)
+        continue;
+      same = true;
+      if (v.evidence.log_likelihood > o.evidence.log_likelihood) o = std::move(v);
+      break;
+    }
+    if (!same) refined.push_back(std::move(v));
+  }
+  if (refined.empty())
+    throw AnalysisError("[registerClouds] no overlap: none of the " + std::to_string(hyps.size()) +
+                        " plane alignments leaves " + std::to_string(p.min_overlap_points) +
+                        " points of each cloud within " + formatFixed(p.crossed_radius_m) +
+                        " m of the other; the clouds must see some of the same surfaces");
+  // Poses that fit the overlap first; among them the one the free space contradicts least.
+  std::sort(refined.begin(), refined.end(), [](const Verified& a, const Verified& b) {
+    return a.fits != b.fits ? a.fits : a.evidence.log_likelihood > b.evidence.log_likelihood;
+  });
+  if (std::getenv("SAILSHAPE_DEBUG_REG")) {
+    for (size_t i = 0; i < std::min<size_t>(hyps.size(), 8); ++i)
+      std::fprintf(stderr, "screen %zu: %s LL %.1f on %zu hidden %zu free %zu planes_on %zu\n", i, describePose(hyps[i].candidate.transform).c_str(),
+                   hyps[i].screen.consistency, hyps[i].screen.on_surface, hyps[i].screen.hidden, hyps[i].screen.in_free_space, hyps[i].candidate.planes_on);
+    for (const Verified& v : refined)
+      std::fprintf(stderr, "refined: %s fits %d LL %.1f on %zu hidden %zu free %zu\n", describePose(v.refinement.transform).c_str(),
+                   v.fits, v.evidence.log_likelihood, v.evidence.on_surface, v.evidence.hidden, v.evidence.in_free_space);
+  }
+  const Verified& best = refined.front();
+  reportPairings(*best.hypothesis, dr.planes, dm.planes, out);
+  out.coarse = best.hypothesis->candidate.transform;
+  out.coarse_overlap_fraction = static_cast<double>(best.evidence.on_surface) /
+                                static_cast<double>(std::max<size_t>(1, best.evidence.per_sample.size()));
+  out.free_space_fraction = static_cast<double>(best.evidence.in_free_space) /
+                            static_cast<double>(std::max<size_t>(1, best.evidence.per_sample.size()));
+  out.poses_verified = refined.size();
+  if (refined.size() > 1 && refined[1].fits) {
+    const PoseComparison c = verifier.compare(best.evidence, refined[1].evidence);
+    out.log_likelihood_ratio = c.log_ratio;
+    out.log_likelihood_ratio_needed = c.needed;
+    if (!c.decisive) {
+      out.ambiguous = true;
+      out.warnings.push_back(
+          "ambiguous: " + std::to_string(refined.size()) + " poses fit; the likeliest, " +
+          describePose(best.refinement.transform) + " (" + std::to_string(best.evidence.in_free_space) +
+          " samples in the other unit's free space), beats " + describePose(refined[1].refinement.transform) + " (" +
+          std::to_string(refined[1].evidence.in_free_space) + ") by a log-likelihood ratio of " +
+          formatFixed(c.log_ratio, 1) + " where " + formatFixed(c.needed, 1) +
+          " is needed — decide with --pairs, --plane-hints, or a reference cube both units see");
+    }
+  }
+  return best.refinement;
+}
+
 }  // namespace
 
 RigidTransform transformFromPlanes(const DetectedPlane (&reference)[3], const DetectedPlane (&moving)[3]) {
@@ -449,58 +624,49 @@ Registration registerClouds(const Cloud& reference, const Cloud& moving, const R
   checkParams(reference, moving, p);
   Registration out;
   out.method = p.method;
-  RigidTransform coarse = RigidTransform::Identity();
-  std::vector<PlaneAnchor> anchors;
+  Refinement refinement;
   if (p.method == "planes") {
-    coarse = planeAlignment(reference, moving, p, progress, out, anchors);
-  } else if (p.method == "svd") {
-    const KabschFit fit = fitKabsch(p.pairs);
-    coarse = fit.transform;
-    if (fit.reflection_corrected)
-      out.warnings.push_back("the picked pairs fit a reflection best; the nearest rotation was used — check the pairs");
-    if (fit.rms_m > p.uncertainty_m)
-      out.warnings.push_back("picked pairs disagree by " + formatFixed(fit.rms_m * 1000, 1) + " mm RMS, above the " +
-                             formatFixed(p.uncertainty_m * 1000, 1) + " mm uncertainty (picking error)");
+    refinement = choosePlanePose(reference, moving, p, progress, out);
   } else {
-    // Plain ICP from the raw pose: wide correspondences over both whole clouds.
-    IcpParams ip = p.icp;
-    ip.method = "point-to-point";
-    ip.max_correspondence_m = p.icp_initial_correspondence_m;
-    const Cloud ref_sub = selectPoints(reference, thin(allIndices(reference.size()), p.max_icp_points));
-    const Cloud mov_sub = selectPoints(moving, thin(allIndices(moving.size()), p.max_icp_points));
-    const IcpResult icp = refineIcp(ref_sub, mov_sub, p.initial, ip, progress);
-    for (const auto& w : icp.warnings) out.warnings.push_back("plain ICP: " + w);
-    coarse = icp.transform;
+    RigidTransform coarse = RigidTransform::Identity();
+    if (p.method == "svd") {
+      const KabschFit fit = fitKabsch(p.pairs);
+      coarse = fit.transform;
+      if (fit.reflection_corrected)
+        out.warnings.push_back("the picked pairs fit a reflection best; the nearest rotation was used — check the pairs");
+      if (fit.rms_m > p.uncertainty_m)
+        out.warnings.push_back("picked pairs disagree by " + formatFixed(fit.rms_m * 1000, 1) + " mm RMS, above the " +
+                               formatFixed(p.uncertainty_m * 1000, 1) + " mm uncertainty (picking error)");
+    } else {
+      // Plain ICP from the raw pose: wide correspondences over both whole clouds.
+      IcpParams ip = p.icp;
+      ip.method = "point-to-point";
+      ip.max_correspondence_m = p.icp_initial_correspondence_m;
+      const Cloud ref_sub = selectPoints(reference, thin(allIndices(reference.size()), p.max_icp_points));
+      const Cloud mov_sub = selectPoints(moving, thin(allIndices(moving.size()), p.max_icp_points));
+      const IcpResult icp = refineIcp(ref_sub, mov_sub, p.initial, ip, progress);
+      for (const auto& w : icp.warnings) out.warnings.push_back("plain ICP: " + w);
+      coarse = icp.transform;
+    }
+    out.coarse = coarse;
+    refinement = refinePose(reference, moving, coarse, {}, p, progress);
   }
-  out.coarse = coarse;
-
   // Crossed filter: only the overlap can hold right correspondences.
-  const CrossedFilter overlap = crossedFilter(reference, transformCloud(moving, coarse), p.crossed_radius_m);
+  const CrossedFilter& overlap = refinement.overlap;
   out.overlap_reference_points = overlap.reference.size();
   out.overlap_moving_points = overlap.moving.size();
-  if (overlap.moving.size() < p.min_overlap_points || overlap.reference.size() < p.min_overlap_points)
+  if (!refinement.enough_overlap)
     throw AnalysisError("[registerClouds] no overlap: after the " + p.method + " alignment only " +
                         std::to_string(overlap.moving.size()) + " moving and " +
                         std::to_string(overlap.reference.size()) + " reference points have a point of the other cloud within " +
                         formatFixed(p.crossed_radius_m) + " m (need " + std::to_string(p.min_overlap_points) +
                         "); the clouds must see some of the same surfaces");
+  for (const auto& w : refinement.warnings) out.warnings.push_back(w);
   const Cloud mov_overlap = selectPoints(moving, overlap.moving);
-  out.before_refinement = nearestDistanceStats(reference, transformCloud(mov_overlap, coarse));
-
-  const Cloud ref_sub = selectPoints(reference, thin(overlap.reference, p.max_icp_points));
-  const Cloud mov_sub = selectPoints(moving, thin(overlap.moving, p.max_icp_points));
-  RigidTransform final_t = coarse;
-  out.converged = true;
-  if (p.refine) {
-    IcpParams ip = p.icp;
-    ip.max_correspondence_m = std::min(ip.max_correspondence_m, p.crossed_radius_m);
-    const IcpResult icp =
-        refineIcp(ref_sub, mov_sub, coarse, ip, progress, ip.method == "point-to-plane" ? anchors : std::vector<PlaneAnchor>{});
-    for (const auto& w : icp.warnings) out.warnings.push_back("refinement: " + w);
-    out.icp_iterations = icp.iterations;
-    out.converged = icp.converged;
-    final_t = icp.transform;
-  }
+  out.before_refinement = nearestDistanceStats(reference, transformCloud(mov_overlap, out.coarse));
+  out.icp_iterations = refinement.iterations;
+  out.converged = refinement.converged;
+  const RigidTransform final_t = refinement.transform;
   out.transform = final_t;
   out.rotation = final_t.linear();
   out.translation = final_t.translation();
@@ -521,6 +687,7 @@ Registration registerClouds(const Cloud& reference, const Cloud& moving, const R
   out.accepted = out.below_uncertainty && out.inlier_fraction >= p.min_inlier_fraction && out.converged && !out.ambiguous;
   return out;
 }
+
 
 Drift compareTransforms(const RigidTransform& stored, const RigidTransform& fresh, double radius_m,
                         double max_displacement_m) {
