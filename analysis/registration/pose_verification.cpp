@@ -158,7 +158,7 @@ PoseEvidence PoseVerifier::evaluate(const RigidTransform& moving_to_reference, s
     const double free = std::log(p_.free_space_outlier_rate) + hidden;
     std::vector<double> ell(static_cast<size_t>(count));
     std::vector<char> kind(static_cast<size_t>(count));
-#pragma omp parallel
+#pragma omp parallel if (count > 4000)
     {
       std::vector<uint32_t> idx;
       std::vector<double> d2;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -297,7 +298,7 @@ std::vector<Candidate> matchPlaneSets(const PlaneSets& sets, const std::vector<D
       bool seen = false;
       for (const Candidate& other : candidates) seen = seen || sameTransform(other.transform, c.transform);
       if (seen) continue;
-      c.score = scorer.score(c.transform, c.planes_on);
+      // Scored later, once solved from every plane it lands (planeHypotheses).
       candidates.push_back(c);
     }
   }
@@ -355,6 +356,7 @@ struct Hypothesis {
   Candidate candidate;  // the plane set it came from; transform: solved from every landed plane
   std::vector<size_t> on;
   PoseEvidence screen;
+  bool determined = false;  // the planes it lands fix every degree of freedom
 };
 
 // Every distinct pose the matched planes allow, each solved jointly from all the
@@ -362,8 +364,10 @@ struct Hypothesis {
 std::vector<Hypothesis> planeHypotheses(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
                                         const Progress& progress, Registration& out, PlaneDetection& dr,
                                         PlaneDetection& dm) {
+  auto t0 = std::chrono::steady_clock::now();
   dr = detectPlanes(reference, p.planes, progress);
   dm = detectPlanes(moving, p.planes, progress);
+  if (std::getenv("SAILSHAPE_DEBUG_REG")) std::fprintf(stderr, "planes %zu %zu: %.2f s\n", dr.planes.size(), dm.planes.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   for (const auto& w : dr.warnings) out.warnings.push_back("reference planes: " + w);
   for (const auto& w : dm.warnings) out.warnings.push_back("moving planes: " + w);
   out.reference_planes = dr.planes.size();
@@ -530,26 +534,72 @@ struct Verified {
 Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
                            const Progress& progress, Registration& out) {
   PlaneDetection dr, dm;
+  auto t0 = std::chrono::steady_clock::now();
+  auto lap = [&](const char* what) { if (std::getenv("SAILSHAPE_DEBUG_REG")) std::fprintf(stderr, "%s: %.2f s\n", what, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()); };
   std::vector<Hypothesis> hyps = planeHypotheses(reference, moving, p, progress, out, dr, dm);
+  lap("hypotheses");
   const PoseVerifier verifier(reference, moving, p.verify);
+  lap("verifier");
   // Poses closer than the crossed radius everywhere over the moving cloud are one.
   double extent = 0;
   const Vec3 centre = moving.viewpoint.value_or(Vec3::Zero());
   for (const Vec3& q : moving.points) extent = std::max(extent, (q - centre).norm());
-  for (Hypothesis& h : hyps) h.screen = verifier.evaluate(h.candidate.transform, p.screen_samples);
-  std::sort(hyps.begin(), hyps.end(),
-            [](const Hypothesis& a, const Hypothesis& b) { return a.screen.consistency > b.screen.consistency; });
+  // A pose is determined when the planes it lands fix all six degrees of
+  // freedom (normals with an independent triple; a pair with a picked pair):
+  // a pose landing fewer overlaps little and so is contradicted by little,
+  // which is no evidence for it. Determined poses are ranked by their
+  // free-space evidence, then by planes landed.
+  const PlaneIndependence independent{p.match};
+  auto determined = [&](const Hypothesis& h) {
+    std::vector<size_t> landed;
+    for (size_t k = 0; k < h.on.size(); ++k)
+      if (h.on[k] < dr.planes.size()) landed.push_back(k);
+    if (p.pairs.size() == 1) return h.candidate.planes_on >= 2;
+    for (size_t a = 0; a < landed.size(); ++a)
+      for (size_t b = a + 1; b < landed.size(); ++b)
+        for (size_t c = b + 1; c < landed.size(); ++c)
+          if (independent.triple(dm.planes[landed[a]].normal, dm.planes[landed[b]].normal, dm.planes[landed[c]].normal))
+            return true;
+    return false;
+  };
+  for (Hypothesis& h : hyps) {
+    h.screen = verifier.evaluate(h.candidate.transform, p.screen_samples);
+    h.determined = determined(h);
+  }
+  auto rank = [](const Hypothesis& h) { return h.determined; };
+  std::sort(hyps.begin(), hyps.end(), [&](const Hypothesis& a, const Hypothesis& b) {
+    if (rank(a) != rank(b)) return rank(a);
+    if (a.screen.log_likelihood != b.screen.log_likelihood) return a.screen.log_likelihood > b.screen.log_likelihood;
+    if (a.candidate.planes_on != b.candidate.planes_on) return a.candidate.planes_on > b.candidate.planes_on;
+    return a.screen.consistency > b.screen.consistency;
+  });
+  lap("screen");
   std::vector<Verified> refined;
-  for (size_t i = 0; i < hyps.size() && i < p.refined_hypotheses; ++i) {
-    progress("verifying poses", static_cast<double>(i) / static_cast<double>(std::min(hyps.size(), p.refined_hypotheses)));
+  // Candidates are refined on a quarter of the points (the choice needs the
+  // basin, not the last 0.1 mm); the winner is refined again on all of them.
+  RegistrationParams quick = p;
+  quick.max_icp_points = std::max<size_t>(100, p.max_icp_points / 4);
+  // Refined: the screen's best and every pose the screen cannot yet reject
+  // against it (with enough overlap), up to refined_hypotheses; at least two.
+  size_t to_refine = 0;
+  while (to_refine < hyps.size() && to_refine < p.refined_hypotheses &&
+         rank(hyps[to_refine]) && (to_refine < 2 || !verifier.compare(hyps[0].screen, hyps[to_refine].screen).decisive))
+    ++to_refine;
+  if (to_refine == 0)
+    throw AnalysisError("[registerClouds] none of the " + std::to_string(hyps.size()) +
+                        " plane matches lands planes of the moving cloud that fix the pose (three with independent "
+                        "normals on reference planes): the units see too few of the same planes — decide with --pairs, "
+                        "--plane-hints, or a reference cube both units see");
+  for (size_t i = 0; i < to_refine; ++i) {
+    progress("verifying poses", static_cast<double>(i) / static_cast<double>(to_refine));
     Verified v;
     v.hypothesis = &hyps[i];
     v.refinement = refinePose(reference, moving, hyps[i].candidate.transform,
-                              planeAnchors(moving, hyps[i], dr.planes, dm.planes, p.max_anchor_points), p, {});
+                              planeAnchors(moving, hyps[i], dr.planes, dm.planes, quick.max_anchor_points), quick, {});
     if (!v.refinement.enough_overlap) continue;
     v.evidence = verifier.evaluate(v.refinement.transform);
     const SurfaceFit fit = surfaceFit(reference, transformCloud(moving, v.refinement.transform), p.crossed_radius_m,
-                                      p.uncertainty_m, p.icp.normal_k, p.max_icp_points);
+                                      p.uncertainty_m, p.icp.normal_k, quick.max_icp_points);
     v.fits = fit.points > 0 && fit.rms_m <= p.uncertainty_m && fit.inlier_fraction >= p.min_inlier_fraction &&
              v.refinement.converged;
     // Two hypotheses ICP brought to one pose are one pose.
@@ -568,12 +618,13 @@ Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const Re
                         " plane alignments leaves " + std::to_string(p.min_overlap_points) +
                         " points of each cloud within " + formatFixed(p.crossed_radius_m) +
                         " m of the other; the clouds must see some of the same surfaces");
+  lap("refined");
   // Poses that fit the overlap first; among them the one the free space contradicts least.
   std::sort(refined.begin(), refined.end(), [](const Verified& a, const Verified& b) {
     return a.fits != b.fits ? a.fits : a.evidence.log_likelihood > b.evidence.log_likelihood;
   });
   if (std::getenv("SAILSHAPE_DEBUG_REG")) {
-    for (size_t i = 0; i < std::min<size_t>(hyps.size(), 8); ++i)
+    for (size_t i = 0; i < hyps.size(); ++i)
       std::fprintf(stderr, "screen %zu: %s LL %.1f on %zu hidden %zu free %zu planes_on %zu\n", i, describePose(hyps[i].candidate.transform).c_str(),
                    hyps[i].screen.consistency, hyps[i].screen.on_surface, hyps[i].screen.hidden, hyps[i].screen.in_free_space, hyps[i].candidate.planes_on);
     for (const Verified& v : refined)
@@ -603,7 +654,9 @@ Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const Re
           " is needed — decide with --pairs, --plane-hints, or a reference cube both units see");
     }
   }
-  return best.refinement;
+  if (!p.refine) return best.refinement;
+  return refinePose(reference, moving, best.refinement.transform,
+                    planeAnchors(moving, *best.hypothesis, dr.planes, dm.planes, p.max_anchor_points), p, progress);
 }
 
 }  // namespace

@@ -46,13 +46,14 @@ struct RegistrationParams {
   // planes + point-to-plane refinement: points of each matched moving plane
   // (evenly spread) held to its reference plane alongside the overlap pairs.
   size_t max_anchor_points = 5'000;
-  // planes: every pose the matched planes allow is screened by the verifier's
-  // likelihood on this many samples of each cloud; the likeliest
-  // `refined_hypotheses` are refined by ICP and scored on all its samples, and
-  // the best must beat the runner-up by the verifier's margin (else ambiguous).
+  // planes: every pose the matched planes allow is screened by the verifier on
+  // this many samples of each cloud; the best and those the screen cannot reject
+  // against it (at most `refined_hypotheses`) are refined by ICP and scored on
+  // all its samples, and the best must beat the runner-up by the verifier's
+  // margin (else ambiguous).
   PoseVerificationParams verify;
-  size_t screen_samples = 400;
-  size_t refined_hypotheses = 4;
+  size_t screen_samples = 1500;
+  size_t refined_hypotheses = 8;
   // Sensor uncertainty the fitness must stay under: σ + systematic error at model
   // scale (SPEC §4 step 4: 9 mm; 14 mm at full scale).
   double uncertainty_m = 0.009;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 
@@ -94,7 +95,7 @@ RandomCase randomRegistrationCase(uint64_t seed) {
   RandomCase c;
   RoomSceneParams& p = c.params;
   p.seed = seed;
-  p.alpha_step_deg = p.beta_step_deg = 1.0;
+  p.alpha_step_deg = p.beta_step_deg = 0.5;
   p.deck = U(rng) < 0.2;
   const double ly = uni(2.6, 4.2);
   const double lz = U(rng) < 0.3 ? ly : uni(2.2, 3.2);  // a square cross-section: 90° turns fit the walls too
@@ -120,30 +121,69 @@ RandomCase randomRegistrationCase(uint64_t seed) {
     const Eigen::Quaterniond q(uni(-1, 1), uni(-1, 1), uni(-1, 1), uni(-1, 1));
     return q.normalized().toRotationMatrix();
   };
-  p.reference_pose = RigidTransform::Identity();
-  p.reference_pose.linear() = rotation();
-  p.reference_pose.translation() = origin();
-  p.moving_pose = RigidTransform::Identity();
-  p.moving_pose.linear() = rotation();
-  do p.moving_pose.translation() = origin();
-  while ((p.moving_pose.translation() - p.reference_pose.translation()).norm() < 1.0);
   // Partial views: a mirror window of 180–270° and a sweep of 120–180°.
   const double window = uni(180, 270);
   p.alpha_first_deg = uni(-135, 135 - window);
   p.alpha_last_deg = p.alpha_first_deg + window;
   p.beta_span_deg = uni(120, 180);
+  // Mostly the units are set up to see the cube (the middle of their view on
+  // it, turned any way about that line, as a crew would place them); else anyhow.
+  const bool aimed = cube && U(rng) < 0.85;
+  const double mid = (p.alpha_first_deg + p.alpha_last_deg) / 2 * kRadPerDeg;
+  const Vec3 middle_beam(std::cos(mid), std::sin(mid), 0);
+  auto pose = [&](const Vec3& o) {
+    RigidTransform t = RigidTransform::Identity();
+    t.linear() = rotation();
+    t.translation() = o;
+    if (aimed) t.linear() = Eigen::Quaterniond::FromTwoVectors(t.linear() * middle_beam, *p.cube_centre - o).toRotationMatrix() * t.linear();
+    return t;
+  };
+  p.reference_pose = pose(origin());
+  Vec3 o;
+  do o = origin();
+  while ((o - p.reference_pose.translation()).norm() < 1.0);
+  p.moving_pose = pose(o);
   p.noise_scale = U(rng) < 0.25 ? 0.0 : uni(0.5, 1.6);
   const bool systematic = U(rng) < 0.33;
   if (systematic) {
     p.reference_systematic_fraction = uni(0, 0.003);
     p.moving_systematic_fraction = uni(0, 0.003);
   }
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "%s %.1f×%.1f×%.1f m, %s, noise ×%.2f, range error %.2f/%.2f %%",
-                p.deck ? "deck" : "room", lx, ly, lz, cube ? "cube" : "no cube", p.noise_scale,
+  c.scene = makeRoomScene(p);
+  const unsigned ref_faces = cubeFacesSeen(c.scene.reference, p.reference_pose, p, 200);
+  const unsigned mov_faces = cubeFacesSeen(c.scene.moving, p.moving_pose, p, 200);
+  // The bottom face (bit 4) stands on the floor: what lies there is floor.
+  const int common = __builtin_popcount(ref_faces & mov_faces & ~(1u << 4));
+  if (std::getenv("SAILSHAPE_DEBUG_REG")) std::printf("faces %x %x\n", ref_faces, mov_faces);
+  c.decidable = common >= 2;
+  char buf[240];
+  std::snprintf(buf, sizeof buf, "%s %.1f×%.1f×%.1f m, %s (%d faces seen by both), noise ×%.2f, range error %.2f/%.2f %%",
+                p.deck ? "deck" : "room", lx, ly, lz, cube ? "cube" : "no cube", common, p.noise_scale,
                 100 * p.reference_systematic_fraction, 100 * p.moving_systematic_fraction);
   c.label = buf;
   return c;
+}
+
+}  // namespace sailshape
+
+namespace sailshape {
+
+unsigned cubeFacesSeen(const Cloud& cloud, const RigidTransform& pose, const RoomSceneParams& p, size_t min_points) {
+  if (!p.cube_centre) return 0;
+  const Eigen::Matrix3d rz = Eigen::AngleAxisd(p.cube_yaw_deg * kRadPerDeg, Vec3::UnitZ()).toRotationMatrix();
+  const double h = p.cube_size_m / 2;
+  size_t counts[6] = {0, 0, 0, 0, 0, 0};
+  for (const Vec3& q : cloud.points) {
+    const Vec3 local = rz.transpose() * (pose * q - *p.cube_centre);
+    if (local.cwiseAbs().maxCoeff() > h + 0.01) continue;
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side)
+        if (std::abs(local[axis] - (side ? h : -h)) < 0.01) ++counts[2 * axis + side];
+  }
+  unsigned faces = 0;
+  for (int f = 0; f < 6; ++f)
+    if (counts[f] >= min_points) faces |= 1u << f;
+  return faces;
 }
 
 }  // namespace sailshape

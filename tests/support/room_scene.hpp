@@ -64,9 +64,18 @@ namespace sailshape {
 // time), two units anywhere inside at any orientation, windows and ranges that
 // leave partial overlap, noise 0–1.6 × SPEC §3's σ and a systematic range error
 // of up to 0.3 % per unit (in a third of the cases). `label` says which.
+// Cases where both units see the same two faces of the cube (≥ 200 returns, the plane detector's least region
+// each) are `decidable`: the cube breaks the room's symmetry for both. The
+// others (no cube, or one unit misses it) may be right to refuse.
 struct RandomCase {
   RoomSceneParams params;
+  RoomScene scene;
   std::string label;
+  bool decidable = false;
 };
 RandomCase randomRegistrationCase(uint64_t seed);
+
+// Which faces of the cube (bit 2·axis + side, cube frame) a unit's cloud (its
+// own frame, unit → scene pose) holds at least `min_points` returns on (within 1 cm).
+unsigned cubeFacesSeen(const Cloud& cloud, const RigidTransform& pose, const RoomSceneParams& params, size_t min_points);
 }  // namespace sailshape

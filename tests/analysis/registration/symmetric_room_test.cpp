@@ -37,6 +37,9 @@ TEST(SymmetricRoom, TheStudyTransformIsFoundOrRefusedNeverWrong) {
     const RoomScene s = makeRoomScene(studyRoom(noise, 11));
     ASSERT_GT(s.reference.size(), 20000u);
     ASSERT_GT(s.moving.size(), 20000u);
+    const RoomSceneParams p = studyRoom(noise, 11);
+    std::printf("cube faces seen: reference %x, moving %x\n", cubeFacesSeen(s.reference, p.reference_pose, p, 200),
+                cubeFacesSeen(s.moving, p.moving_pose, p, 200));
     const Registration r = registerClouds(s.reference, s.moving);
     const double rot = rotationDifferenceDeg(r.rotation, s.truth.linear());
     const double tr = (r.translation - s.truth.translation()).norm();
