@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
 
 #include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
 #include "analysis/spatial/neighbours.hpp"
+#include "analysis/segmentation/mixed_pixels.hpp"
 #include "analysis/spatial/normals.hpp"
 
 namespace sailshape {
@@ -28,7 +30,7 @@ double upperQuantile(double alpha) {
 // nearest range its beams met in every direction (free space lies before it),
 // and its samples.
 struct PoseVerifier::Side {
-  const Cloud& cloud;
+  Cloud cloud;
   KdTree tree;
   std::vector<Vec3> normals;
   std::vector<uint32_t> samples;
@@ -41,8 +43,20 @@ struct PoseVerifier::Side {
   int n_az = 0, n_el = 0;
   std::vector<float> nearest_range, farthest_range;
 
-  Side(const Cloud& c, size_t sample_count)
-      : cloud(c), tree(c.points), has_viewpoint(c.viewpoint.has_value()) {
+  // Mixed pixels (SPEC §3: a beam straddling an edge returns a range between
+  // the surfaces) hang in the free space before the farther surface, where a
+  // right pose then seems to put points: they are left out when the scan
+  // angles allow finding them.
+  static Cloud withoutMixedPixels(const Cloud& c, double sigma_m) {
+    if (!c.hasScanAngles() || !c.viewpoint) return c;
+    MixedPixelParams mp;
+    mp.sensor_sigma_m = sigma_m;
+    return selectPoints(c, removeMixedPixels(c, mp).kept);
+  }
+
+  Side(const Cloud& input, size_t sample_count, double sigma_m)
+      : cloud(withoutMixedPixels(input, sigma_m)), tree(cloud.points), has_viewpoint(cloud.viewpoint.has_value()) {
+    const Cloud& c = cloud;
     if (has_viewpoint) origin = *c.viewpoint;
     if (!has_viewpoint) {  // the fallback scores distances to the tangent planes
       NormalParams np;
@@ -132,8 +146,8 @@ PoseVerifier::PoseVerifier(const Cloud& reference, const Cloud& moving, const Po
   if (reference.size() < 20 || moving.size() < 20)
     bad("both clouds need at least 20 points (reference " + std::to_string(reference.size()) + ", moving " +
         std::to_string(moving.size()) + ")");
-  reference_ = std::make_unique<Side>(reference, p.samples_per_cloud);
-  moving_ = std::make_unique<Side>(moving, p.samples_per_cloud);
+  reference_ = std::make_unique<Side>(reference, p.samples_per_cloud, p.sigma_m);
+  moving_ = std::make_unique<Side>(moving, p.samples_per_cloud, p.sigma_m);
 }
 
 PoseVerifier::~PoseVerifier() = default;
@@ -158,6 +172,8 @@ PoseEvidence PoseVerifier::evaluate(const RigidTransform& moving_to_reference, s
     const double free = std::log(p_.free_space_outlier_rate) + hidden;
     std::vector<double> ell(static_cast<size_t>(count));
     std::vector<char> kind(static_cast<size_t>(count));
+    std::vector<int64_t> cell(static_cast<size_t>(count), 0);
+    const double cell_m = p_.coincidence_cell_m;
 #pragma omp parallel if (count > 4000)
     {
       std::vector<uint32_t> idx;
@@ -198,17 +214,27 @@ PoseEvidence PoseVerifier::evaluate(const RigidTransform& moving_to_reference, s
         }
         ell[static_cast<size_t>(s)] = l;
         kind[static_cast<size_t>(s)] = k;
+        const auto c = [&](double x) { return static_cast<int64_t>(std::floor(x / cell_m)) & 0x1FFFFF; };
+        cell[static_cast<size_t>(s)] = (c(q.x()) << 42) | (c(q.y()) << 21) | c(q.z());
       }
     }
     const double violation = std::log(p_.free_space_outlier_rate);
+    std::unordered_map<int64_t, double> cells;  // coincidence per cell, its best sample's
     for (size_t s = 0; s < ell.size(); ++s) {
       ev.consistency += ell[s];
       const double l = kind[s] == 2 ? violation : 0.0;
       ev.log_likelihood += l;
       ev.per_sample.push_back(l);
       (kind[s] == 0 ? ev.on_surface : kind[s] == 1 ? ev.hidden : ev.in_free_space)++;
+      if (kind[s] == 0) {
+        double& w = cells[cell[s]];
+        w = std::max(w, ell[s] - hidden);
+      }
     }
+    for (const auto& [key, w] : cells) ev.coincidence += w;
+    ev.coincident_cells += cells.size();
   }
+  ev.log_likelihood += ev.coincidence;
   return ev;
 }
 
@@ -224,7 +250,7 @@ PoseComparison PoseVerifier::compare(const PoseEvidence& best, const PoseEvidenc
     sum += d;
     sum2 += d * d;
   }
-  c.log_ratio = sum;
+  c.log_ratio = best.log_likelihood - other.log_likelihood;
   const double mean = n ? sum / static_cast<double>(n) : 0.0;
   const double var = n > 1 ? std::max(0.0, (sum2 - static_cast<double>(n) * mean * mean) / static_cast<double>(n - 1)) : 0.0;
   c.standard_error = std::sqrt(static_cast<double>(n) * var);

@@ -8,14 +8,16 @@
 // its beam crossed — impossible for a right pose but for the rate ε of stray
 // returns (mixed pixels at edges). σ_e² = 2σ² + s²(r₁² + r₂²): both units'
 // random error and the systematic range error s (SPEC §3).
-//   evidence (log-likelihood): Σ log ε over the samples in free space, both ways.
-// Samples on the other's surface, hidden behind it or out of its view carry no
-// evidence here: how much two scans overlap depends on where the units stand and
-// where their beams graze, not on whether the pose is right (a floor-for-ceiling
-// swap that brings the units to one height overlaps more than the truth).
-// `consistency` does score overlap (a sample among the other's returns counts
-// log 1/(their range spread + 6σ_e), one hidden or unseen log 1/L, L the other's
-// longest range): it ranks the many plane matches before refinement.
+// A sample among the other's returns that way (within their range span [near,
+// far] widened by 3σ_e) coincides with its surface: a point anywhere along the
+// beam (density 1/L, L the other's longest range) lands there with odds
+// L / (far − near + 6σ_e). Coincidences count once per cell (coincidence_cell_m):
+// samples on one surface coincide together, and counted one by one they would
+// reward where the units' beams happen to be dense rather than the pose (a
+// floor-for-ceiling swap that brings the units to one height overlaps more).
+//   log-likelihood = Σ_cells log(L / span) + Σ_samples in free space log ε
+// Samples hidden behind the other's surface or out of its view carry nothing.
+// `consistency` (every sample's log-density) ranks plane matches coarsely.
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,22 +32,28 @@ struct PoseVerificationParams {
   double systematic_fraction = 0.003;     // systematic range error bound (SPEC §3: up to 0.3 % of range)
   double free_space_outlier_rate = 0.01;  // ε
   size_t samples_per_cloud = 20000;       // evenly spread over each cloud
-  double match_radius_m = 0.05;           // a point farther than this from the other cloud is not on its surface
+  double match_radius_m = 0.05;           // without viewpoints: a point farther than this from the other cloud is off its surface
+  // Coincident surface counts once per cell of this size (the smallest plane the
+  // detector accepts): neighbouring samples on one surface coincide together,
+  // so their coincidences are one piece of evidence, not one per sample.
+  double coincidence_cell_m = 0.25;
   // Risk of accepting the wrong one of two poses: the log-likelihood ratio must
   // exceed log(1/α) and z_α standard errors of the per-sample differences.
   double false_accept_probability = 1e-6;
 };
 
 struct PoseEvidence {
-  double log_likelihood = 0;  // free-space evidence, Σ of per_sample
-  double consistency = 0;     // overlap score, for ranking only
+  double log_likelihood = 0;  // coincidence + Σ per_sample
+  double coincidence = 0;     // Σ over cells holding coincident samples of log(L / span)
+  size_t coincident_cells = 0;
+  double consistency = 0;     // per-sample overlap score, for ranking only
   size_t on_surface = 0, hidden = 0, in_free_space = 0;
-  std::vector<double> per_sample;  // evidence of each sample, reference samples then moving samples
+  std::vector<double> per_sample;  // free-space evidence of each sample, reference samples then moving samples
 };
 
 struct PoseComparison {
-  double log_ratio = 0;       // ℓ(best) − ℓ(other), summed
-  double standard_error = 0;  // √n · sd of the per-sample differences
+  double log_ratio = 0;       // log_likelihood(best) − log_likelihood(other)
+  double standard_error = 0;  // √n · sd of the per-sample free-space differences
   double needed = 0;          // max(log(1/α), z_α · standard_error)
   bool decisive = false;      // log_ratio > needed
 };

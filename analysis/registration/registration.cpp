@@ -628,8 +628,8 @@ Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const Re
       std::fprintf(stderr, "screen %zu: %s LL %.1f on %zu hidden %zu free %zu planes_on %zu\n", i, describePose(hyps[i].candidate.transform).c_str(),
                    hyps[i].screen.consistency, hyps[i].screen.on_surface, hyps[i].screen.hidden, hyps[i].screen.in_free_space, hyps[i].candidate.planes_on);
     for (const Verified& v : refined)
-      std::fprintf(stderr, "refined: %s fits %d LL %.1f on %zu hidden %zu free %zu\n", describePose(v.refinement.transform).c_str(),
-                   v.fits, v.evidence.log_likelihood, v.evidence.on_surface, v.evidence.hidden, v.evidence.in_free_space);
+      std::fprintf(stderr, "refined: %s fits %d LL %.1f cells %zu on %zu hidden %zu free %zu\n", describePose(v.refinement.transform).c_str(),
+                   v.fits, v.evidence.log_likelihood, v.evidence.coincident_cells, v.evidence.on_surface, v.evidence.hidden, v.evidence.in_free_space);
   }
   const Verified& best = refined.front();
   reportPairings(*best.hypothesis, dr.planes, dm.planes, out);

@@ -109,10 +109,19 @@ RandomCase randomRegistrationCase(uint64_t seed) {
   p.cube_yaw_deg = uni(0, 90);
   if (p.deck) p.mast_foot = Vec3(uni(-1, 1), uni(-0.5, 0.5), 0);
   // Unit origins inside, clear of the walls, the cube and each other; any orientation.
+  // Set up for the cube (most cases), both units stand before the same two
+  // side faces of it, as a crew would place them to see one corner.
+  const bool aimed = cube && U(rng) < 0.85;
+  const double corner_yaw = (p.cube_yaw_deg + 45 + 90 * std::floor(uni(0, 4))) * kRadPerDeg;
+  const Vec3 corner_dir(std::cos(corner_yaw), std::sin(corner_yaw), 0);
   auto origin = [&] {
-    for (;;) {
+    for (int attempt = 0;; ++attempt) {
       const Vec3 o(uni(-lx / 2 + 0.5, lx / 2 - 0.5), uni(-ly / 2 + 0.5, ly / 2 - 0.5), uni(0.8, lz - 0.5));
       if (p.cube_centre && (o - *p.cube_centre).norm() < 1.0) continue;
+      if (aimed && attempt < 2000) {  // within ±30° of the corner's diagonal, so both faces face it
+        const Vec3 d = (o - *p.cube_centre).cwiseProduct(Vec3(1, 1, 0)).normalized();
+        if (d.dot(corner_dir) < std::cos(30 * kRadPerDeg)) continue;
+      }
       if (p.mast_foot && std::hypot(o.x() - p.mast_foot->x(), o.y() - p.mast_foot->y()) < 0.5) continue;
       return o;
     }
@@ -126,9 +135,8 @@ RandomCase randomRegistrationCase(uint64_t seed) {
   p.alpha_first_deg = uni(-135, 135 - window);
   p.alpha_last_deg = p.alpha_first_deg + window;
   p.beta_span_deg = uni(120, 180);
-  // Mostly the units are set up to see the cube (the middle of their view on
-  // it, turned any way about that line, as a crew would place them); else anyhow.
-  const bool aimed = cube && U(rng) < 0.85;
+  // Units set up for the cube look at it with the middle of their view, turned
+  // any way about that line; the others are turned anyhow.
   const double mid = (p.alpha_first_deg + p.alpha_last_deg) / 2 * kRadPerDeg;
   const Vec3 middle_beam(std::cos(mid), std::sin(mid), 0);
   auto pose = [&](const Vec3& o) {
