@@ -143,6 +143,7 @@ PoseVerifier::PoseVerifier(const Cloud& reference, const Cloud& moving, const Po
     bad("false_accept_probability must be in (0, 0.5)");
   if (p.samples_per_cloud < 10) bad("samples_per_cloud must be >= 10");
   if (!(p.match_radius_m > 0)) bad("match_radius_m must be > 0");
+  if (!(p.coincidence_cell_m > 0)) bad("coincidence_cell_m must be > 0");
   if (reference.size() < 20 || moving.size() < 20)
     bad("both clouds need at least 20 points (reference " + std::to_string(reference.size()) + ", moving " +
         std::to_string(moving.size()) + ")");
@@ -219,20 +220,29 @@ PoseEvidence PoseVerifier::evaluate(const RigidTransform& moving_to_reference, s
       }
     }
     const double violation = std::log(p_.free_space_outlier_rate);
-    std::unordered_map<int64_t, double> cells;  // coincidence per cell, its best sample's
+    struct CellTally {
+      double best = 0;        // the largest log(L / span) of its coincident samples
+      size_t on = 0, all = 0;
+    };
+    std::unordered_map<int64_t, CellTally> cells;
     for (size_t s = 0; s < ell.size(); ++s) {
       ev.consistency += ell[s];
       const double l = kind[s] == 2 ? violation : 0.0;
       ev.log_likelihood += l;
       ev.per_sample.push_back(l);
       (kind[s] == 0 ? ev.on_surface : kind[s] == 1 ? ev.hidden : ev.in_free_space)++;
+      CellTally& t = cells[cell[s]];
+      ++t.all;
       if (kind[s] == 0) {
-        double& w = cells[cell[s]];
-        w = std::max(w, ell[s] - hidden);
+        ++t.on;
+        t.best = std::max(t.best, ell[s] - hidden);
       }
     }
-    for (const auto& [key, w] : cells) ev.coincidence += w;
-    ev.coincident_cells += cells.size();
+    for (const auto& [key, t] : cells) {
+      if (t.on == 0) continue;
+      ev.coincidence += t.best * static_cast<double>(t.on) / static_cast<double>(t.all);
+      ++ev.coincident_cells;
+    }
   }
   ev.log_likelihood += ev.coincidence;
   return ev;

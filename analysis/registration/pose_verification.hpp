@@ -11,11 +11,13 @@
 // A sample among the other's returns that way (within their range span [near,
 // far] widened by 3σ_e) coincides with its surface: a point anywhere along the
 // beam (density 1/L, L the other's longest range) lands there with odds
-// L / (far − near + 6σ_e). Coincidences count once per cell (coincidence_cell_m):
-// samples on one surface coincide together, and counted one by one they would
-// reward where the units' beams happen to be dense rather than the pose (a
-// floor-for-ceiling swap that brings the units to one height overlaps more).
-//   log-likelihood = Σ_cells log(L / span) + Σ_samples in free space log ε
+// L / (far − near + 6σ_e). Coincidences count once per cell (coincidence_cell_m),
+// weighted by the fraction of the cell's samples that coincide: samples on one
+// surface coincide together, and counted one by one they would reward where the
+// units' beams happen to be dense rather than the pose (a floor-for-ceiling swap
+// that brings the units to one height overlaps more); a surface that merely
+// crosses the other's coincides along a line, a small fraction of its cells.
+//   log-likelihood = Σ_cells f·log(L / span) + Σ_samples in free space log ε
 // Samples hidden behind the other's surface or out of its view carry nothing.
 // `consistency` (every sample's log-density) ranks plane matches coarsely.
 #include <memory>
@@ -44,7 +46,7 @@ struct PoseVerificationParams {
 
 struct PoseEvidence {
   double log_likelihood = 0;  // coincidence + Σ per_sample
-  double coincidence = 0;     // Σ over cells holding coincident samples of log(L / span)
+  double coincidence = 0;     // Σ over cells holding coincident samples of f·log(L / span)
   size_t coincident_cells = 0;
   double consistency = 0;     // per-sample overlap score, for ranking only
   size_t on_surface = 0, hidden = 0, in_free_space = 0;

@@ -4,9 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <chrono>
 #include <cstdio>
-#include <cstdlib>
+#include <limits>
 #include <string>
 
 #include "analysis/core/errors.hpp"
@@ -69,8 +68,11 @@ void checkParams(const Cloud& reference, const Cloud& moving, const Registration
   if (!(p.icp_initial_correspondence_m > 0))
     bad("icp_initial_correspondence_m must be > 0 (got " + std::to_string(p.icp_initial_correspondence_m) + ")");
   if (p.max_icp_points < 100) bad("max_icp_points must be >= 100 (got " + std::to_string(p.max_icp_points) + ")");
-  if (p.match.verify_samples < 10) bad("match.verify_samples must be >= 10");
   if (!(p.match.verify_radius_m > 0)) bad("match.verify_radius_m must be > 0");
+  if (p.verify.samples_per_cloud < 10 || p.screen_samples < 10)
+    bad("verify.samples_per_cloud and screen_samples must be >= 10 (got " + std::to_string(p.verify.samples_per_cloud) +
+        ", " + std::to_string(p.screen_samples) + ")");
+  if (p.refined_hypotheses < 1) bad("refined_hypotheses must be >= 1");
   if (!(p.match.max_angle_mismatch_deg > 0)) bad("match.max_angle_mismatch_deg must be > 0");
   if (!(p.match.min_plane_angle_deg > 0 && p.match.min_plane_angle_deg <= 90))
     bad("match.min_plane_angle_deg must be in (0, 90] (got " + std::to_string(p.match.min_plane_angle_deg) + ")");
@@ -101,7 +103,6 @@ size_t planeNearest(const Cloud& cloud, const std::vector<DetectedPlane>& planes
 struct Candidate {
   RigidTransform transform;
   size_t ref[3], mov[3];
-  size_t score = 0;      // sampled moving points near the reference
   size_t planes_on = 0;  // moving planes lying on a matching reference plane
 };
 
@@ -165,25 +166,20 @@ PlaneSets planeSets(const Cloud& reference, const Cloud& moving, const PlaneDete
   return sets;
 }
 
-// Scores candidate alignments of the moving cloud onto the reference: first by
-// how many moving planes land on a reference plane of the same orientation with
-// overlapping points (a symmetric chamber maps walls onto walls either way; the
-// cube and other small planes decide), then by how many sampled moving points
-// come near the reference.
+// Which reference plane each moving plane lands on under a candidate pose: one
+// of the same orientation holding the nearest reference point of at least a
+// tenth of the moving plane's samples (up to 100 of its points).
 class CandidateScorer {
  public:
   CandidateScorer(const Cloud& reference, const Cloud& moving, const std::vector<DetectedPlane>& R,
                   const std::vector<DetectedPlane>& M, const PlaneMatchParams& m)
       : moving_(moving), R_(R), M_(M), m_(m), ref_tree_(reference.points),
-        samples_(thin(allIndices(moving.size()), m.verify_samples)), r2_(m.verify_radius_m * m.verify_radius_m),
+        r2_(m.verify_radius_m * m.verify_radius_m),
         ref_label_(reference.size(), static_cast<uint32_t>(R.size())) {
     for (size_t j = 0; j < R.size(); ++j)
       for (uint32_t i : R[j].indices) ref_label_[i] = static_cast<uint32_t>(j);
     for (const DetectedPlane& pl : M) plane_samples_.push_back(thin(pl.indices, 100));
   }
-
-  // The sampled moving points a score counts among.
-  size_t samples() const { return samples_.size(); }
 
   // The reference plane each moving plane lands on under t (R.size(): none).
   std::vector<size_t> landings(const RigidTransform& t) const {
@@ -204,36 +200,16 @@ class CandidateScorer {
     return on;
   }
 
-  // The sampled moving points t brings near the reference; the planes it lands
-  // go to planes_on. Scoring in turn, a candidate that lands fewer planes than
-  // the best so far can neither win nor tie: it scores 0 without a point count.
-  size_t score(const RigidTransform& t, size_t& planes_on) {
-    std::vector<uint32_t> idx;
-    std::vector<double> d2;
-    planes_on = 0;
-    for (size_t j : landings(t)) planes_on += j < R_.size();
-    if (planes_on < best_planes_on_) return size_t{0};
-    best_planes_on_ = planes_on;
-    size_t count = 0;
-    for (uint32_t i : samples_) {
-      ref_tree_.nearest(t * moving_.points[i], 1, idx, d2);
-      count += !d2.empty() && d2[0] <= r2_;
-    }
-    return count;
-  }
-
  private:
   const Cloud& moving_;
   const std::vector<DetectedPlane>& R_;  // reference planes
   const std::vector<DetectedPlane>& M_;  // moving planes
   const PlaneMatchParams& m_;
   const KdTree ref_tree_;
-  const std::vector<uint32_t> samples_;
   const double r2_;
   // Which reference plane each reference point belongs to (R.size(): none).
   std::vector<uint32_t> ref_label_;
   std::vector<std::vector<uint32_t>> plane_samples_;  // per moving plane, up to 100 of its points
-  size_t best_planes_on_ = 0;
 };
 
 // Every distinct alignment that maps a moving plane set onto a reference set with
@@ -241,7 +217,7 @@ class CandidateScorer {
 // set passed the angle test. Reports progress per reference set.
 std::vector<Candidate> matchPlaneSets(const PlaneSets& sets, const std::vector<DetectedPlane>& R,
                                       const std::vector<DetectedPlane>& M, const RegistrationParams& p,
-                                      const PlaneIndependence& independent, size_t need, CandidateScorer& scorer,
+                                      const PlaneIndependence& independent, size_t need,
                                       const Progress& progress, bool& any_moving_set) {
   const bool pair_translation = p.pairs.size() == 1;
   const double tol = p.match.max_angle_mismatch_deg;
@@ -364,10 +340,8 @@ struct Hypothesis {
 std::vector<Hypothesis> planeHypotheses(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
                                         const Progress& progress, Registration& out, PlaneDetection& dr,
                                         PlaneDetection& dm) {
-  auto t0 = std::chrono::steady_clock::now();
   dr = detectPlanes(reference, p.planes, progress);
   dm = detectPlanes(moving, p.planes, progress);
-  if (std::getenv("SAILSHAPE_DEBUG_REG")) std::fprintf(stderr, "planes %zu %zu: %.2f s\n", dr.planes.size(), dm.planes.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   for (const auto& w : dr.warnings) out.warnings.push_back("reference planes: " + w);
   for (const auto& w : dm.warnings) out.warnings.push_back("moving planes: " + w);
   out.reference_planes = dr.planes.size();
@@ -392,7 +366,7 @@ std::vector<Hypothesis> planeHypotheses(const Cloud& reference, const Cloud& mov
   CandidateScorer scorer(reference, moving, R, M, m);
   bool any_moving_set = false;
   const std::vector<Candidate> candidates =
-      matchPlaneSets(sets, R, M, p, independent, need, scorer, progress, any_moving_set);
+      matchPlaneSets(sets, R, M, p, independent, need, progress, any_moving_set);
   if (candidates.empty())
     throw AnalysisError(std::string("[registerClouds] no ") + (need == 3 ? "three" : "two") +
                         " planes of the moving cloud match the angles between the reference planes within " +
@@ -525,7 +499,62 @@ struct Verified {
   Refinement refinement;
   PoseEvidence evidence;
   bool fits = false;  // on its own it would pass the fitness, inlier and convergence tests
+  size_t planes_on = 0;  // moving planes it lands on reference planes
 };
+
+// The scene's own symmetries, turned onto a pose: a box room maps onto itself
+// turned 90°, 180° or 270° about a line along one of its axes, so when `lead`
+// is wrong the truth may be lead turned so — and a plane match may never have
+// proposed it (the units saw different walls). For each axis (the reference
+// planes' normals) and turn, the line's position is searched over the reference
+// cloud's extent (0.2 m steps, then 0.04 m); the likeliest turned pose of each comes back.
+std::vector<RigidTransform> symmetricAlternatives(const Cloud& reference, const std::vector<DetectedPlane>& R,
+                                                  const PlaneIndependence& independent, const PoseVerifier& verifier,
+                                                  const RigidTransform& lead, size_t samples) {
+  std::vector<Vec3> axes;
+  for (const DetectedPlane& pl : R) {
+    bool known = false;
+    for (const Vec3& a : axes) known = known || !independent.pair(a, pl.normal);
+    if (!known && axes.size() < 3) axes.push_back(pl.normal);
+  }
+  Vec3 lo = reference.points.front(), hi = lo;
+  for (const Vec3& q : reference.points) {
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  const Vec3 mid = (lo + hi) / 2;
+  const double half = (hi - lo).norm() / 2;
+  std::vector<RigidTransform> out;
+  for (const Vec3& a : axes) {
+    const Vec3 u = a.unitOrthogonal(), v = a.cross(u);
+    for (int quarter = 1; quarter <= 3; ++quarter) {
+      const Eigen::Matrix3d turn = Eigen::AngleAxisd(quarter * M_PI / 2, a).toRotationMatrix();
+      auto posed = [&](const Vec3& c) {
+        RigidTransform t = lead;
+        t.linear() = turn * lead.linear();
+        t.translation() = turn * lead.translation() + (c - turn * c);
+        return t;
+      };
+      Vec3 best_c = mid;
+      double best = -std::numeric_limits<double>::infinity();
+      for (double step : {0.2, 0.04}) {
+        const double span = step == 0.2 ? half : 0.2;
+        const Vec3 centre = best_c;
+        for (double i = -span; i <= span + 1e-9; i += step)
+          for (double j = -span; j <= span + 1e-9; j += step) {
+            const Vec3 c = centre + i * u + j * v;
+            const double ll = verifier.evaluate(posed(c), samples).log_likelihood;
+            if (ll > best) {
+              best = ll;
+              best_c = c;
+            }
+          }
+      }
+      out.push_back(posed(best_c));
+    }
+  }
+  return out;
+}
 
 // The plane method: every hypothesis screened by its likelihood on a few
 // samples, the likeliest refined by ICP and scored on all samples both ways;
@@ -534,12 +563,8 @@ struct Verified {
 Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
                            const Progress& progress, Registration& out) {
   PlaneDetection dr, dm;
-  auto t0 = std::chrono::steady_clock::now();
-  auto lap = [&](const char* what) { if (std::getenv("SAILSHAPE_DEBUG_REG")) std::fprintf(stderr, "%s: %.2f s\n", what, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()); };
   std::vector<Hypothesis> hyps = planeHypotheses(reference, moving, p, progress, out, dr, dm);
-  lap("hypotheses");
   const PoseVerifier verifier(reference, moving, p.verify);
-  lap("verifier");
   // Poses closer than the crossed radius everywhere over the moving cloud are one.
   double extent = 0;
   const Vec3 centre = moving.viewpoint.value_or(Vec3::Zero());
@@ -573,7 +598,6 @@ Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const Re
     if (a.candidate.planes_on != b.candidate.planes_on) return a.candidate.planes_on > b.candidate.planes_on;
     return a.screen.consistency > b.screen.consistency;
   });
-  lap("screen");
   std::vector<Verified> refined;
   // Candidates are refined on a quarter of the points (the choice needs the
   // basin, not the last 0.1 mm); the winner is refined again on all of them.
@@ -613,24 +637,44 @@ Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const Re
     }
     if (!same) refined.push_back(std::move(v));
   }
+  // The likeliest so far, turned by the room's symmetries, competes too: the
+  // truth may be one of them when no plane match proposed it.
+  if (!refined.empty() && p.symmetric_alternatives) {
+    const Verified* lead = &refined.front();
+    for (const Verified& v : refined)
+      if (v.fits && (!lead->fits || v.evidence.log_likelihood > lead->evidence.log_likelihood)) lead = &v;
+    const Hypothesis* lead_h = lead->hypothesis;
+    const RigidTransform lead_t = lead->refinement.transform;
+    const std::vector<RigidTransform> alts = symmetricAlternatives(reference, dr.planes, independent, verifier, lead_t,
+                                                                   std::min<size_t>(p.screen_samples, 300));
+    std::vector<std::pair<double, RigidTransform>> ranked;
+    for (const RigidTransform& t : alts) ranked.push_back({verifier.evaluate(t, p.screen_samples).log_likelihood, t});
+    std::sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+    for (size_t k = 0; k < ranked.size() && k < 2; ++k) {
+      Verified v;
+      v.hypothesis = lead_h;
+      v.refinement = refinePose(reference, moving, ranked[k].second, {}, quick, {});
+      if (!v.refinement.enough_overlap) continue;
+      v.evidence = verifier.evaluate(v.refinement.transform);
+      const SurfaceFit fit = surfaceFit(reference, transformCloud(moving, v.refinement.transform), p.crossed_radius_m,
+                                        p.uncertainty_m, p.icp.normal_k, quick.max_icp_points);
+      v.fits = fit.points > 0 && fit.rms_m <= p.uncertainty_m && fit.inlier_fraction >= p.min_inlier_fraction &&
+               v.refinement.converged;
+      bool same = false;
+      for (const Verified& o : refined)
+        same = same || !compareTransforms(o.refinement.transform, v.refinement.transform, extent, p.crossed_radius_m).moved;
+      if (!same) refined.push_back(std::move(v));
+    }
+  }
   if (refined.empty())
     throw AnalysisError("[registerClouds] no overlap: none of the " + std::to_string(hyps.size()) +
                         " plane alignments leaves " + std::to_string(p.min_overlap_points) +
                         " points of each cloud within " + formatFixed(p.crossed_radius_m) +
                         " m of the other; the clouds must see some of the same surfaces");
-  lap("refined");
   // Poses that fit the overlap first; among them the one the free space contradicts least.
   std::sort(refined.begin(), refined.end(), [](const Verified& a, const Verified& b) {
     return a.fits != b.fits ? a.fits : a.evidence.log_likelihood > b.evidence.log_likelihood;
   });
-  if (std::getenv("SAILSHAPE_DEBUG_REG")) {
-    for (size_t i = 0; i < hyps.size(); ++i)
-      std::fprintf(stderr, "screen %zu: %s LL %.1f on %zu hidden %zu free %zu planes_on %zu\n", i, describePose(hyps[i].candidate.transform).c_str(),
-                   hyps[i].screen.consistency, hyps[i].screen.on_surface, hyps[i].screen.hidden, hyps[i].screen.in_free_space, hyps[i].candidate.planes_on);
-    for (const Verified& v : refined)
-      std::fprintf(stderr, "refined: %s fits %d LL %.1f cells %zu on %zu hidden %zu free %zu\n", describePose(v.refinement.transform).c_str(),
-                   v.fits, v.evidence.log_likelihood, v.evidence.coincident_cells, v.evidence.on_surface, v.evidence.hidden, v.evidence.in_free_space);
-  }
   const Verified& best = refined.front();
   reportPairings(*best.hypothesis, dr.planes, dm.planes, out);
   out.coarse = best.hypothesis->candidate.transform;
@@ -639,7 +683,22 @@ Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const Re
   out.free_space_fraction = static_cast<double>(best.evidence.in_free_space) /
                             static_cast<double>(std::max<size_t>(1, best.evidence.per_sample.size()));
   out.poses_verified = refined.size();
-  if (refined.size() > 1 && refined[1].fits) {
+  // Planes landed speak too: a fitting pose that lands as many of them as the
+  // likeliest leaves the choice open whatever the free space says (on the
+  // tunnel fixture without occlusion the free space favours a pose 90° off).
+  const CandidateScorer landing(reference, moving, dr.planes, dm.planes, p.match);
+  for (Verified& v : refined)
+    for (size_t j : landing.landings(v.refinement.transform)) v.planes_on += j < dr.planes.size();
+  for (size_t i = 1; i < refined.size() && !out.ambiguous; ++i)
+    if (refined[i].fits && refined[i].planes_on >= best.planes_on) {
+      out.ambiguous = true;
+      out.warnings.push_back("ambiguous: the likeliest pose, " + describePose(best.refinement.transform) + ", lands " +
+                             std::to_string(best.planes_on) + " planes, and another, " +
+                             describePose(refined[i].refinement.transform) + ", lands " +
+                             std::to_string(refined[i].planes_on) +
+                             " — decide with --pairs, --plane-hints, or a reference cube both units see");
+    }
+  if (!out.ambiguous && refined.size() > 1 && refined[1].fits) {
     const PoseComparison c = verifier.compare(best.evidence, refined[1].evidence);
     out.log_likelihood_ratio = c.log_ratio;
     out.log_likelihood_ratio_needed = c.needed;

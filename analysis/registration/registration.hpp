@@ -22,8 +22,7 @@ struct PlaneMatchParams {
   double max_angle_mismatch_deg = 3.0;  // angles between plane normals must agree this well in both clouds
   double min_plane_angle_deg = 30.0;    // planes used together are at least this far from parallel
   double min_triple_det = 0.25;         // |det| of the three unit normals whose intersection gives the translation
-  size_t verify_samples = 2000;         // moving points that score each candidate match
-  double verify_radius_m = 0.05;        // a sample counts when a reference point lies this close
+  double verify_radius_m = 0.05;        // a moving plane's sample lands when a reference plane point lies this close
 };
 
 struct RegistrationParams {
@@ -54,6 +53,9 @@ struct RegistrationParams {
   PoseVerificationParams verify;
   size_t screen_samples = 1500;
   size_t refined_hypotheses = 8;
+  // The likeliest pose turned by the room's symmetries (90°, 180°, 270° about
+  // each plane axis, the line placed where the data fit best) competes too.
+  bool symmetric_alternatives = true;
   // Sensor uncertainty the fitness must stay under: σ + systematic error at model
   // scale (SPEC §4 step 4: 9 mm; 14 mm at full scale).
   double uncertainty_m = 0.009;

@@ -162,7 +162,6 @@ RandomCase randomRegistrationCase(uint64_t seed) {
   const unsigned mov_faces = cubeFacesSeen(c.scene.moving, p.moving_pose, p, 200);
   // The bottom face (bit 4) stands on the floor: what lies there is floor.
   const int common = __builtin_popcount(ref_faces & mov_faces & ~(1u << 4));
-  if (std::getenv("SAILSHAPE_DEBUG_REG")) std::printf("faces %x %x\n", ref_faces, mov_faces);
   c.decidable = common >= 2;
   char buf[240];
   std::snprintf(buf, sizeof buf, "%s %.1f×%.1f×%.1f m, %s (%d faces seen by both), noise ×%.2f, range error %.2f/%.2f %%",
