@@ -502,6 +502,22 @@ struct Verified {
   size_t planes_on = 0;  // moving planes it lands on reference planes
 };
 
+// A pose refined by ICP from `start` (on `quick`'s share of the points), scored
+// by the verifier and tested on its own; refinement.enough_overlap false: no overlap.
+Verified verifyPose(const Cloud& reference, const Cloud& moving, const RigidTransform& start,
+                    const std::vector<PlaneAnchor>& anchors, const RegistrationParams& quick,
+                    const PoseVerifier& verifier) {
+  Verified v;
+  v.refinement = refinePose(reference, moving, start, anchors, quick, {});
+  if (!v.refinement.enough_overlap) return v;
+  v.evidence = verifier.evaluate(v.refinement.transform);
+  const SurfaceFit fit = surfaceFit(reference, transformCloud(moving, v.refinement.transform), quick.crossed_radius_m,
+                                    quick.uncertainty_m, quick.icp.normal_k, quick.max_icp_points);
+  v.fits = fit.points > 0 && fit.rms_m <= quick.uncertainty_m && fit.inlier_fraction >= quick.min_inlier_fraction &&
+           v.refinement.converged;
+  return v;
+}
+
 // The scene's own symmetries, turned onto a pose: a box room maps onto itself
 // turned 90°, 180° or 270° about a line along one of its axes, so when `lead`
 // is wrong the truth may be lead turned so — and a plane match may never have
@@ -616,16 +632,10 @@ Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const Re
                         "--plane-hints, or a reference cube both units see");
   for (size_t i = 0; i < to_refine; ++i) {
     progress("verifying poses", static_cast<double>(i) / static_cast<double>(to_refine));
-    Verified v;
+    Verified v = verifyPose(reference, moving, hyps[i].candidate.transform,
+                            planeAnchors(moving, hyps[i], dr.planes, dm.planes, quick.max_anchor_points), quick, verifier);
     v.hypothesis = &hyps[i];
-    v.refinement = refinePose(reference, moving, hyps[i].candidate.transform,
-                              planeAnchors(moving, hyps[i], dr.planes, dm.planes, quick.max_anchor_points), quick, {});
     if (!v.refinement.enough_overlap) continue;
-    v.evidence = verifier.evaluate(v.refinement.transform);
-    const SurfaceFit fit = surfaceFit(reference, transformCloud(moving, v.refinement.transform), p.crossed_radius_m,
-                                      p.uncertainty_m, p.icp.normal_k, quick.max_icp_points);
-    v.fits = fit.points > 0 && fit.rms_m <= p.uncertainty_m && fit.inlier_fraction >= p.min_inlier_fraction &&
-             v.refinement.converged;
     // Two hypotheses ICP brought to one pose are one pose.
     bool same = false;
     for (Verified& o : refined) {
@@ -651,15 +661,9 @@ Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const Re
     for (const RigidTransform& t : alts) ranked.push_back({verifier.evaluate(t, p.screen_samples).log_likelihood, t});
     std::sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
     for (size_t k = 0; k < ranked.size() && k < 2; ++k) {
-      Verified v;
+      Verified v = verifyPose(reference, moving, ranked[k].second, {}, quick, verifier);
       v.hypothesis = lead_h;
-      v.refinement = refinePose(reference, moving, ranked[k].second, {}, quick, {});
       if (!v.refinement.enough_overlap) continue;
-      v.evidence = verifier.evaluate(v.refinement.transform);
-      const SurfaceFit fit = surfaceFit(reference, transformCloud(moving, v.refinement.transform), p.crossed_radius_m,
-                                        p.uncertainty_m, p.icp.normal_k, quick.max_icp_points);
-      v.fits = fit.points > 0 && fit.rms_m <= p.uncertainty_m && fit.inlier_fraction >= p.min_inlier_fraction &&
-               v.refinement.converged;
       bool same = false;
       for (const Verified& o : refined)
         same = same || !compareTransforms(o.refinement.transform, v.refinement.transform, extent, p.crossed_radius_m).moved;
