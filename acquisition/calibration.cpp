@@ -74,6 +74,9 @@ void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
 
 void validateTargets(const std::vector<CalibrationTarget>& targets, const CalibrationParams& params) {
   if (targets.empty()) throw InvalidInput("[calibrateUnit] no target given");
+  if (!(params.sensor_sigma_m > 0) || !(params.max_rms_sigmas > 0))
+    throw InvalidInput("[calibrateUnit] sensor_sigma_m and max_rms_sigmas must be > 0 (got " +
+                       std::to_string(params.sensor_sigma_m) + ", " + std::to_string(params.max_rms_sigmas) + ")");
   if (!(params.initial_p_m > 0))
     throw InvalidInput("[calibrateUnit] initial_p_m must be > 0 (got " + std::to_string(params.initial_p_m) +
                        "): at p = 0 the angle θ has no effect");
@@ -255,7 +258,7 @@ void dropOutliers(Fit& f, const CalibrationParams& params) {
 }
 
 // Per-target residuals and shapes, p and θ in their positive form, standard errors and warnings.
-void reportFit(const Fit& f, CalibrationResult& result) {
+void reportFit(const Fit& f, const CalibrationParams& params, CalibrationResult& result) {
   size_t used = 0;
   double total = 0;
   for (size_t k = 0; k < f.targets.size(); ++k) {
@@ -299,6 +302,14 @@ void reportFit(const Fit& f, CalibrationResult& result) {
     result.theta_stderr_rad = std::sqrt(std::max(0.0, cov(1, 1)));
   }
   if (!result.converged) result.warnings.push_back("the least-squares fit did not converge");
+  for (const CalibrationTargetResult& t : result.targets)
+    if (t.rms_m > params.max_rms_sigmas * params.sensor_sigma_m) {
+      result.plausible = false;
+      result.warnings.push_back("target " + t.name + " fits its shape to " + std::to_string(t.rms_m * 1000) +
+                                " mm RMS, far above the sensor's " + std::to_string(params.sensor_sigma_m * 1000) +
+                                " mm: it is not one " + "plane or cylinder" +
+                                " (crop it to one face with @box); p and θ are not usable");
+    }
   if (result.theta_stderr_rad > 0.5 * kRadPerDeg)
     result.warnings.push_back("θ is poorly determined (±" + std::to_string(result.theta_stderr_rad * kDegPerRad) +
                               "°): add a second plane at an angle to the first, or sweep a wider β range");
@@ -314,8 +325,73 @@ CalibrationResult calibrateUnit(const std::vector<CalibrationTarget>& targets, c
   result.converged = solve(fit, params, result.iterations);
   dropOutliers(fit, params);
   result.converged = solve(fit, params, result.iterations);
-  reportFit(fit, result);
+  reportFit(fit, params, result);
   return result;
+}
+
+}  // namespace sailshape
+
+namespace sailshape {
+
+namespace {
+
+// Least-squares plane through points: unit normal and offset (n·x = d).
+void planeOf(const std::vector<Vec3>& pts, Vec3& n, double& d) {
+  Vec3 c = Vec3::Zero();
+  for (const Vec3& q : pts) c += q;
+  c /= static_cast<double>(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3& q : pts) cov += (q - c) * (q - c).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  n = es.eigenvectors().col(0).normalized();
+  d = n.dot(c);
+}
+
+}  // namespace
+
+RangeScaleFit fitRangeScale(const std::vector<KnownSpan>& spans) {
+  if (spans.empty()) throw InvalidInput("[fitRangeScale] no span given");
+  RangeScaleFit fit;
+  double md = 0, dd = 0;
+  for (const KnownSpan& s : spans) {
+    if (s.face_a.size() < 10 || s.face_b.size() < 10)
+      throw InvalidInput("[fitRangeScale] span '" + s.name + "' needs at least 10 points on each face (got " +
+                         std::to_string(s.face_a.size()) + " and " + std::to_string(s.face_b.size()) + ")");
+    if (!(s.distance_m > 0))
+      throw InvalidInput("[fitRangeScale] span '" + s.name + "' needs a distance > 0 (got " + std::to_string(s.distance_m) + ")");
+    Vec3 na, nb;
+    double da, db;
+    planeOf(s.face_a, na, da);
+    planeOf(s.face_b, nb, db);
+    if (na.dot(nb) < 0) {
+      nb = -nb;
+      db = -db;
+    }
+    if (na.dot(nb) < std::cos(5 * kRadPerDeg))
+      throw InvalidInput("[fitRangeScale] the faces of span '" + s.name + "' are " +
+                         std::to_string(std::acos(std::min(1.0, na.dot(nb))) * kDegPerRad) + "° from parallel (at most 5°)");
+    const double measured = std::abs(da - db);
+    fit.measured_m.push_back(measured);
+    md += measured * s.distance_m;
+    dd += s.distance_m * s.distance_m;
+  }
+  fit.scale = md / dd;
+  double sum2 = 0;
+  for (size_t i = 0; i < spans.size(); ++i) {
+    const double r = fit.measured_m[i] / fit.scale - spans[i].distance_m;
+    sum2 += r * r;
+  }
+  fit.residual_rms_m = std::sqrt(sum2 / static_cast<double>(spans.size()));
+  if (spans.size() > 1) fit.scale_stderr = std::sqrt(sum2 / static_cast<double>(spans.size() - 1) / dd) * fit.scale;
+  return fit;
+}
+
+Cloud removeRangeScale(const Cloud& cloud, double scale) {
+  if (!(scale > 0)) throw InvalidInput("[removeRangeScale] scale must be > 0 (got " + std::to_string(scale) + ")");
+  Cloud out = cloud;
+  const Vec3 o = cloud.viewpoint.value_or(Vec3::Zero());
+  for (Vec3& q : out.points) q = o + (q - o) / scale;
+  return out;
 }
 
 }  // namespace sailshape

@@ -91,7 +91,9 @@ const std::vector<CommandExamples>& examples() {
         "scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,1.7,2.1 --unit assets/unit-tunnel-leeward.json --write-unit "
         "leeward-calibrated.json",
         "sailshape scanner calibrate --plane scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,-2.1,-1.7 --plane "
-        "scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,1.7,2.1 --p0 0.1 --theta0 10 --json calibration.json"}},
+        "scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,1.7,2.1 --p0 0.1 --theta0 10 --json calibration.json --span "
+        // The floor and the ceiling 3.8 m apart (the tunnel's height) give the range scale.
+        "scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,-2.1,-1.7:scan1/tunnel-leeward.samples.csv@-8,8,-2.5,11,1.7,2.1=3.8"}},
   };
   return table;
 }

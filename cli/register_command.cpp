@@ -121,6 +121,10 @@ void run(const RegisterOptions& o) {
       nlohmann::json pl = {{"reference", r.reference_planes},
                            {"moving", r.moving_planes},
                            {"candidates", r.candidates},
+                           {"poses_verified", r.poses_verified},
+                           {"free_space_fraction", r.free_space_fraction},
+                           {"log_likelihood_ratio", r.log_likelihood_ratio},
+                           {"log_likelihood_ratio_needed", r.log_likelihood_ratio_needed},
                            {"moving_planes_on_reference", r.coarse_planes_on},
                            {"pairings", nlohmann::json::array()}};
       for (const PlanePairing& pp : r.pairings)

@@ -26,6 +26,7 @@ struct CalibrateOptions {
   bool p0_set = false, theta0_set = false;
   std::string json;
   std::string write_unit;
+  std::vector<std::string> spans;
 };
 
 // "FILE" or "FILE@xmin,xmax,ymin,ymax,zmin,zmax": samples kept inside the box (unit frame, metres, under the
@@ -61,9 +62,33 @@ CalibrationTarget loadTarget(const std::string& spec, double p0, double theta0) 
   return t;
 }
 
+// "A[@box]:B[@box]=DISTANCE": two parallel faces a known distance apart, their points in the unit frame under p, θ.
+KnownSpan loadSpan(const std::string& spec, double p, double theta) {
+  const auto eq = spec.rfind('=');
+  const auto comma = spec.find(':');
+  double distance = 0;
+  try {
+    if (eq != std::string::npos) distance = std::stod(spec.substr(eq + 1));
+  } catch (const std::exception&) {
+    distance = 0;
+  }
+  if (eq == std::string::npos || comma == std::string::npos || comma > eq || !(distance > 0))
+    throw InvalidInput("[scanner calibrate] '" + spec + "': a span is FACE_A:FACE_B=DISTANCE_M (each face a samples file, "
+                       "optionally @box) with a distance > 0");
+  KnownSpan span;
+  span.name = spec;
+  span.distance_m = distance;
+  for (int side = 0; side < 2; ++side) {
+    const std::string face = side == 0 ? spec.substr(0, comma) : spec.substr(comma + 1, eq - comma - 1);
+    for (const SweepPoint& s : loadTarget(face, p, theta).samples)
+      (side == 0 ? span.face_a : span.face_b).push_back(unitPoint(s.range_m, s.alpha_rad, s.beta_rad, p, theta));
+  }
+  return span;
+}
+
 void run(const CalibrateOptions& o) {
-  if (o.planes.empty() && o.cylinders.empty())
-    throw InvalidInput("[scanner calibrate] give at least one --plane or --cylinder sample file");
+  if (o.planes.empty() && o.cylinders.empty() && o.spans.empty())
+    throw InvalidInput("[scanner calibrate] give at least one --plane, --cylinder or --span");
   if (o.radii.size() != o.cylinders.size())
     throw InvalidInput("[scanner calibrate] every --cylinder needs its --radius (got " + std::to_string(o.cylinders.size()) +
                        " cylinders and " + std::to_string(o.radii.size()) + " radii)");
@@ -84,7 +109,31 @@ void run(const CalibrateOptions& o) {
     t.radius_m = o.radii[i];
     targets.push_back(std::move(t));
   }
-  const CalibrationResult r = calibrateUnit(targets, params);
+  CalibrationResult r;
+  r.p_m = params.initial_p_m;
+  r.theta_rad = params.initial_theta_rad;
+  if (!targets.empty()) r = calibrateUnit(targets, params);
+  nlohmann::json scale_doc;
+  if (!o.spans.empty()) {
+    std::vector<KnownSpan> spans;
+    for (const std::string& sp : o.spans) spans.push_back(loadSpan(sp, r.p_m, r.theta_rad));
+    const RangeScaleFit k = fitRangeScale(spans);
+    std::printf("range scale %.5f ± %.5f (systematic range error %+.3f %%), residual %.2f mm over %zu spans\n",
+                k.scale, k.scale_stderr, 100 * (k.scale - 1), 1000 * k.residual_rms_m, spans.size());
+    for (size_t i = 0; i < spans.size(); ++i)
+      std::printf("  %-40s measured %.4f m, true %.4f m, corrected %.4f m\n", spans[i].name.c_str(), k.measured_m[i],
+                  spans[i].distance_m, k.measured_m[i] / k.scale);
+    scale_doc = {{"range_scale", k.scale}, {"range_scale_stderr", k.scale_stderr}, {"residual_rms_m", k.residual_rms_m},
+                 {"measured_m", k.measured_m}};
+    if (k.residual_rms_m > 2 * params.sensor_sigma_m)
+      r.warnings.push_back("the spans disagree by " + std::to_string(1000 * k.residual_rms_m) +
+                           " mm RMS after the scale, beyond the sensor's noise: a face or a distance is wrong");
+  }
+  if (targets.empty()) {
+    for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    if (!o.json.empty()) writeJsonFile(o.json, scale_doc);
+    return;
+  }
   std::printf("p = %.2f mm ± %.2f mm, theta = %.3f deg ± %.3f deg (%s after %d iterations)\n", r.p_m * 1000,
               r.p_stderr_m * 1000, r.theta_rad / kRadPerDeg, r.theta_stderr_rad / kRadPerDeg,
               r.converged ? "converged" : "NOT converged", r.iterations);
@@ -102,12 +151,17 @@ void run(const CalibrateOptions& o) {
                        {"converged", r.converged},
                        {"iterations", r.iterations},
                        {"warnings", r.warnings},
+                       {"plausible", r.plausible},
                        {"targets", nlohmann::json::array()}};
     for (const CalibrationTargetResult& t : r.targets)
       doc["targets"].push_back({{"name", t.name}, {"points", t.points}, {"dropped", t.outliers}, {"rms_m", t.rms_m},
                                 {"max_abs_m", t.max_abs_m}});
+    if (!scale_doc.is_null()) doc["range_scale"] = scale_doc;
     writeJsonFile(o.json, doc);
   }
+  if (!r.plausible)
+    throw AnalysisError("[scanner calibrate] the fit is implausible: a target's residual is far above the sensor's noise "
+                        "(see the table); no unit file written");
   if (!o.write_unit.empty()) {
     if (std::filesystem::exists(o.write_unit))
       throw FileError("[scanner calibrate] " + o.write_unit + " exists already; not overwritten");
@@ -146,6 +200,10 @@ void addScannerCommand(CLI::App& app) {
       ->each([o](const std::string&) { o->p0_set = true; });
   cmd->add_option("--theta0", o->theta0_deg, "Starting θ in degrees (default 0 or the unit's)")
       ->each([o](const std::string&) { o->theta0_set = true; });
+  cmd->add_option("--span", o->spans,
+                  "Two parallel faces a known distance apart, FACE_A:FACE_B=METRES (each face a samples file, "
+                  "optionally @box): the tunnel's width or height, opposite faces of a reference cube. Fits the range "
+                  "scale (systematic range error, SPEC §3) and reports it with its residual; repeat for several spans");
   cmd->add_option("--json", o->json, "Write the result (p_m, theta_deg, standard errors, per-target residuals) as JSON");
   cmd->add_option("--write-unit", o->write_unit,
                   "Write the unit file (from --unit, or defaults) with the calibrated p and θ to this new path");

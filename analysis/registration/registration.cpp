@@ -1,8 +1,11 @@
 #include "analysis/registration/registration.hpp"
 
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "analysis/core/errors.hpp"
@@ -65,8 +68,11 @@ void checkParams(const Cloud& reference, const Cloud& moving, const Registration
   if (!(p.icp_initial_correspondence_m > 0))
     bad("icp_initial_correspondence_m must be > 0 (got " + std::to_string(p.icp_initial_correspondence_m) + ")");
   if (p.max_icp_points < 100) bad("max_icp_points must be >= 100 (got " + std::to_string(p.max_icp_points) + ")");
-  if (p.match.verify_samples < 10) bad("match.verify_samples must be >= 10");
   if (!(p.match.verify_radius_m > 0)) bad("match.verify_radius_m must be > 0");
+  if (p.verify.samples_per_cloud < 10 || p.screen_samples < 10)
+    bad("verify.samples_per_cloud and screen_samples must be >= 10 (got " + std::to_string(p.verify.samples_per_cloud) +
+        ", " + std::to_string(p.screen_samples) + ")");
+  if (p.refined_hypotheses < 1) bad("refined_hypotheses must be >= 1");
   if (!(p.match.max_angle_mismatch_deg > 0)) bad("match.max_angle_mismatch_deg must be > 0");
   if (!(p.match.min_plane_angle_deg > 0 && p.match.min_plane_angle_deg <= 90))
     bad("match.min_plane_angle_deg must be in (0, 90] (got " + std::to_string(p.match.min_plane_angle_deg) + ")");
@@ -97,7 +103,6 @@ size_t planeNearest(const Cloud& cloud, const std::vector<DetectedPlane>& planes
 struct Candidate {
   RigidTransform transform;
   size_t ref[3], mov[3];
-  size_t score = 0;      // sampled moving points near the reference
   size_t planes_on = 0;  // moving planes lying on a matching reference plane
 };
 
@@ -161,25 +166,20 @@ PlaneSets planeSets(const Cloud& reference, const Cloud& moving, const PlaneDete
   return sets;
 }
 
-// Scores candidate alignments of the moving cloud onto the reference: first by
-// how many moving planes land on a reference plane of the same orientation with
-// overlapping points (a symmetric chamber maps walls onto walls either way; the
-// cube and other small planes decide), then by how many sampled moving points
-// come near the reference.
+// Which reference plane each moving plane lands on under a candidate pose: one
+// of the same orientation holding the nearest reference point of at least a
+// tenth of the moving plane's samples (up to 100 of its points).
 class CandidateScorer {
  public:
   CandidateScorer(const Cloud& reference, const Cloud& moving, const std::vector<DetectedPlane>& R,
                   const std::vector<DetectedPlane>& M, const PlaneMatchParams& m)
       : moving_(moving), R_(R), M_(M), m_(m), ref_tree_(reference.points),
-        samples_(thin(allIndices(moving.size()), m.verify_samples)), r2_(m.verify_radius_m * m.verify_radius_m),
+        r2_(m.verify_radius_m * m.verify_radius_m),
         ref_label_(reference.size(), static_cast<uint32_t>(R.size())) {
     for (size_t j = 0; j < R.size(); ++j)
       for (uint32_t i : R[j].indices) ref_label_[i] = static_cast<uint32_t>(j);
     for (const DetectedPlane& pl : M) plane_samples_.push_back(thin(pl.indices, 100));
   }
-
-  // The sampled moving points a score counts among.
-  size_t samples() const { return samples_.size(); }
 
   // The reference plane each moving plane lands on under t (R.size(): none).
   std::vector<size_t> landings(const RigidTransform& t) const {
@@ -200,36 +200,16 @@ class CandidateScorer {
     return on;
   }
 
-  // The sampled moving points t brings near the reference; the planes it lands
-  // go to planes_on. Scoring in turn, a candidate that lands fewer planes than
-  // the best so far can neither win nor tie: it scores 0 without a point count.
-  size_t score(const RigidTransform& t, size_t& planes_on) {
-    std::vector<uint32_t> idx;
-    std::vector<double> d2;
-    planes_on = 0;
-    for (size_t j : landings(t)) planes_on += j < R_.size();
-    if (planes_on < best_planes_on_) return size_t{0};
-    best_planes_on_ = planes_on;
-    size_t count = 0;
-    for (uint32_t i : samples_) {
-      ref_tree_.nearest(t * moving_.points[i], 1, idx, d2);
-      count += !d2.empty() && d2[0] <= r2_;
-    }
-    return count;
-  }
-
  private:
   const Cloud& moving_;
   const std::vector<DetectedPlane>& R_;  // reference planes
   const std::vector<DetectedPlane>& M_;  // moving planes
   const PlaneMatchParams& m_;
   const KdTree ref_tree_;
-  const std::vector<uint32_t> samples_;
   const double r2_;
   // Which reference plane each reference point belongs to (R.size(): none).
   std::vector<uint32_t> ref_label_;
   std::vector<std::vector<uint32_t>> plane_samples_;  // per moving plane, up to 100 of its points
-  size_t best_planes_on_ = 0;
 };
 
 // Every distinct alignment that maps a moving plane set onto a reference set with
@@ -237,7 +217,7 @@ class CandidateScorer {
 // set passed the angle test. Reports progress per reference set.
 std::vector<Candidate> matchPlaneSets(const PlaneSets& sets, const std::vector<DetectedPlane>& R,
                                       const std::vector<DetectedPlane>& M, const RegistrationParams& p,
-                                      const PlaneIndependence& independent, size_t need, CandidateScorer& scorer,
+                                      const PlaneIndependence& independent, size_t need,
                                       const Progress& progress, bool& any_moving_set) {
   const bool pair_translation = p.pairs.size() == 1;
   const double tol = p.match.max_angle_mismatch_deg;
@@ -294,7 +274,7 @@ std::vector<Candidate> matchPlaneSets(const PlaneSets& sets, const std::vector<D
       bool seen = false;
       for (const Candidate& other : candidates) seen = seen || sameTransform(other.transform, c.transform);
       if (seen) continue;
-      c.score = scorer.score(c.transform, c.planes_on);
+      // Scored later, once solved from every plane it lands (planeHypotheses).
       candidates.push_back(c);
     }
   }
@@ -302,47 +282,66 @@ std::vector<Candidate> matchPlaneSets(const PlaneSets& sets, const std::vector<D
   return candidates;
 }
 
-// The best candidate's diagnostics into `out`: its overlap, its plane pairings,
-// and whether another candidate does about as well (an ambiguous match).
-// `candidates` are sorted best first.
-void reportPlaneMatch(const std::vector<Candidate>& candidates, const std::vector<DetectedPlane>& R,
-                      const std::vector<DetectedPlane>& M, const PlaneMatchParams& m, size_t need, size_t samples,
-                      Registration& out) {
-  const Candidate& best = candidates.front();
-  out.candidates = candidates.size();
-  out.coarse_overlap_fraction = static_cast<double>(best.score) / static_cast<double>(samples);
-  out.coarse_planes_on = best.planes_on;
-  for (size_t x = 0; x < need; ++x) {
-    PlanePairing pp;
-    pp.reference_plane = best.ref[x];
-    pp.moving_plane = best.mov[x];
-    pp.reference_normal = R[best.ref[x]].normal;
-    pp.moving_normal = M[best.mov[x]].normal;
-    pp.reference_points = R[best.ref[x]].points;
-    pp.moving_points = M[best.mov[x]].points;
-    out.pairings.push_back(pp);
+// The pose that lays every landed moving plane (on[k]: its reference plane,
+// R.size(): none) on its reference plane in the weighted least-squares sense:
+// the rotation from all normal pairs (Kabsch, each weighted by points × extent²,
+// the inverse variance of a fitted normal), the translation from all offsets
+// (n_r·t = d_r − d_m, weighted by points, the inverse variance of a fitted
+// offset). What the landed planes leave free (a rotation about one normal, a
+// translation along the planes) stays as in `start`.
+RigidTransform jointPlanePose(const RigidTransform& start, const std::vector<size_t>& on,
+                              const std::vector<DetectedPlane>& R, const std::vector<DetectedPlane>& M,
+                              const PlaneIndependence& independent) {
+  std::vector<size_t> landed;
+  for (size_t k = 0; k < M.size(); ++k)
+    if (on[k] < R.size()) landed.push_back(k);
+  bool turns = false;
+  for (size_t a = 0; a < landed.size() && !turns; ++a)
+    for (size_t b = a + 1; b < landed.size() && !turns; ++b) turns = independent.pair(M[landed[a]].normal, M[landed[b]].normal);
+  RigidTransform t = start;
+  auto pairWeight = [](double wr, double wm) { return wr > 0 && wm > 0 ? 1.0 / (1.0 / wr + 1.0 / wm) : 0.0; };
+  if (turns) {
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    for (size_t k : landed) {
+      const DetectedPlane &r = R[on[k]], &m = M[k];
+      const double w = pairWeight(static_cast<double>(r.points) * r.extent_m * r.extent_m,
+                                  static_cast<double>(m.points) * m.extent_m * m.extent_m);
+      h += w * m.normal * r.normal.transpose();
+    }
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    t.linear() = svd.matrixV() * d * svd.matrixU().transpose();
   }
-  for (size_t i = 1; i < candidates.size(); ++i) {
-    if (candidates[i].planes_on < best.planes_on ||
-        static_cast<double>(candidates[i].score) < m.ambiguity_ratio * static_cast<double>(best.score))
-      break;
-    out.ambiguous = true;
-    out.warnings.push_back("ambiguous plane match: another alignment " +
-                           formatFixed(rotationDifferenceDeg(best.transform.linear(), candidates[i].transform.linear()), 1) +
-                           "° and " + formatFixed((best.transform.translation() - candidates[i].transform.translation()).norm()) +
-                           " m away puts as many planes (" + std::to_string(best.planes_on) + ") and " +
-                           std::to_string(candidates[i].score) + " sampled points (best " + std::to_string(best.score) +
-                           ") on the reference; give plane hints or a picked pair");
-    break;
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Vec3 b = Vec3::Zero();
+  for (size_t k : landed) {
+    const DetectedPlane &r = R[on[k]], &m = M[k];
+    const double w = pairWeight(static_cast<double>(r.points), static_cast<double>(m.points));
+    a += w * r.normal * r.normal.transpose();
+    b += w * r.normal * (r.offset_m - m.offset_m);
   }
+  // A vanishing pull towards the start's translation fixes the unconstrained directions.
+  const double lambda = 1e-9 * std::max(a.trace(), 1.0);
+  t.translation() = (a + lambda * Eigen::Matrix3d::Identity()).ldlt().solve(b + lambda * start.translation());
+  return t;
 }
 
-// The study's coarse alignment from matched planes, chosen among every
-// consistent match by how many moving points it brings near the reference.
-RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
-                              const Progress& progress, Registration& out, std::vector<PlaneAnchor>& anchors) {
-  const PlaneDetection dr = detectPlanes(reference, p.planes, progress);
-  const PlaneDetection dm = detectPlanes(moving, p.planes, progress);
+// One pose the planes allow, with the moving planes it lands (ICP anchors).
+struct Hypothesis {
+  Candidate candidate;  // the plane set it came from; transform: solved from every landed plane
+  std::vector<size_t> on;
+  PoseEvidence screen;
+  bool determined = false;  // the planes it lands fix every degree of freedom
+};
+
+// Every distinct pose the matched planes allow, each solved jointly from all the
+// planes it lands; `out` gets the plane counts.
+std::vector<Hypothesis> planeHypotheses(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
+                                        const Progress& progress, Registration& out, PlaneDetection& dr,
+                                        PlaneDetection& dm) {
+  dr = detectPlanes(reference, p.planes, progress);
+  dm = detectPlanes(moving, p.planes, progress);
   for (const auto& w : dr.warnings) out.warnings.push_back("reference planes: " + w);
   for (const auto& w : dm.warnings) out.warnings.push_back("moving planes: " + w);
   out.reference_planes = dr.planes.size();
@@ -364,11 +363,10 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
   const auto& R = dr.planes;
   const auto& M = dm.planes;
   const PlaneSets sets = planeSets(reference, moving, dr, dm, p, independent, need, need_text);
-
   CandidateScorer scorer(reference, moving, R, M, m);
   bool any_moving_set = false;
-  std::vector<Candidate> candidates =
-      matchPlaneSets(sets, R, M, p, independent, need, scorer, progress, any_moving_set);
+  const std::vector<Candidate> candidates =
+      matchPlaneSets(sets, R, M, p, independent, need, progress, any_moving_set);
   if (candidates.empty())
     throw AnalysisError(std::string("[registerClouds] no ") + (need == 3 ? "three" : "two") +
                         " planes of the moving cloud match the angles between the reference planes within " +
@@ -376,22 +374,56 @@ RigidTransform planeAlignment(const Cloud& reference, const Cloud& moving, const
                         (any_moving_set ? "the third normal disagreed" : "no consistent set") +
                         "; reference: " + describePlanes(R) + "; moving: " + describePlanes(M) +
                         ") — give plane hints or picked pairs");
-  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
-    return a.planes_on != b.planes_on ? a.planes_on > b.planes_on : a.score > b.score;
-  });
-  reportPlaneMatch(candidates, R, M, m, need, scorer.samples(), out);
-  const Candidate& best = candidates.front();
-  // Every moving plane that lands on a reference plane anchors the refinement.
-  const std::vector<size_t> on = scorer.landings(best.transform);
+  out.candidates = candidates.size();
+  std::vector<Hypothesis> hyps;
+  for (const Candidate& c : candidates) {
+    Hypothesis h;
+    h.candidate = c;
+    // With a picked pair the translation is the pair's; the planes only turn.
+    RigidTransform t = c.transform;
+    for (int pass = 0; pass < 2 && !pair_translation; ++pass) t = jointPlanePose(t, scorer.landings(t), R, M, independent);
+    h.candidate.transform = t;
+    h.on = scorer.landings(t);
+    h.candidate.planes_on = 0;
+    for (size_t j : h.on) h.candidate.planes_on += j < R.size();
+    bool seen = false;
+    for (const Hypothesis& o : hyps)
+      seen = seen || (rotationDifferenceDeg(o.candidate.transform.linear(), t.linear()) < 1.0 &&
+                      (o.candidate.transform.translation() - t.translation()).norm() < m.verify_radius_m);
+    if (!seen) hyps.push_back(std::move(h));
+  }
+  return hyps;
+}
+
+void reportPairings(const Hypothesis& h, const std::vector<DetectedPlane>& R, const std::vector<DetectedPlane>& M,
+                    Registration& out) {
+  out.coarse_planes_on = h.candidate.planes_on;
+  out.pairings.clear();
   for (size_t k = 0; k < M.size(); ++k) {
-    if (on[k] == R.size()) continue;
+    if (h.on[k] >= R.size()) continue;
+    PlanePairing pp;
+    pp.reference_plane = h.on[k];
+    pp.moving_plane = k;
+    pp.reference_normal = R[h.on[k]].normal;
+    pp.moving_normal = M[k].normal;
+    pp.reference_points = R[h.on[k]].points;
+    pp.moving_points = M[k].points;
+    out.pairings.push_back(pp);
+  }
+}
+
+std::vector<PlaneAnchor> planeAnchors(const Cloud& moving, const Hypothesis& h, const std::vector<DetectedPlane>& R,
+                                      const std::vector<DetectedPlane>& M, size_t max_points) {
+  std::vector<PlaneAnchor> anchors;
+  for (size_t k = 0; k < M.size(); ++k) {
+    if (h.on[k] >= R.size()) continue;
     PlaneAnchor a;
-    a.normal = R[on[k]].normal;
-    a.offset_m = R[on[k]].offset_m;
-    for (uint32_t i : thin(M[k].indices, p.max_anchor_points)) a.moving_points.push_back(moving.points[i]);
+    a.normal = R[h.on[k]].normal;
+    a.offset_m = R[h.on[k]].offset_m;
+    for (uint32_t i : thin(M[k].indices, max_points)) a.moving_points.push_back(moving.points[i]);
     anchors.push_back(std::move(a));
   }
-  return best.transform;
+  return anchors;
 }
 
 // How well the aligned moving cloud lies on the reference surface over their
@@ -431,6 +463,265 @@ SurfaceFit surfaceFit(const Cloud& reference, const Cloud& aligned, double radiu
   return fit;
 }
 
+// ICP from a coarse pose over the crossed overlap (SPEC §4 step 2).
+struct Refinement {
+  RigidTransform transform = RigidTransform::Identity();
+  CrossedFilter overlap;
+  bool enough_overlap = false;
+  int iterations = 0;
+  bool converged = true;
+  std::vector<std::string> warnings;
+};
+
+Refinement refinePose(const Cloud& reference, const Cloud& moving, const RigidTransform& coarse,
+                      const std::vector<PlaneAnchor>& anchors, const RegistrationParams& p, const Progress& progress) {
+  Refinement r;
+  r.transform = coarse;
+  r.overlap = crossedFilter(reference, transformCloud(moving, coarse), p.crossed_radius_m);
+  r.enough_overlap = r.overlap.moving.size() >= p.min_overlap_points && r.overlap.reference.size() >= p.min_overlap_points;
+  if (!r.enough_overlap || !p.refine) return r;
+  const Cloud ref_sub = selectPoints(reference, thin(r.overlap.reference, p.max_icp_points));
+  const Cloud mov_sub = selectPoints(moving, thin(r.overlap.moving, p.max_icp_points));
+  IcpParams ip = p.icp;
+  ip.max_correspondence_m = std::min(ip.max_correspondence_m, p.crossed_radius_m);
+  const IcpResult icp =
+      refineIcp(ref_sub, mov_sub, coarse, ip, progress, ip.method == "point-to-plane" ? anchors : std::vector<PlaneAnchor>{});
+  for (const auto& w : icp.warnings) r.warnings.push_back("refinement: " + w);
+  r.iterations = icp.iterations;
+  r.converged = icp.converged;
+  r.transform = icp.transform;
+  return r;
+}
+
+// A refined plane hypothesis and what the verifier made of it.
+struct Verified {
+  const Hypothesis* hypothesis = nullptr;
+  Refinement refinement;
+  PoseEvidence evidence;
+  bool fits = false;  // on its own it would pass the fitness, inlier and convergence tests
+  size_t planes_on = 0;  // moving planes it lands on reference planes
+};
+
+// A pose refined by ICP from `start` (on `quick`'s share of the points), scored
+// by the verifier and tested on its own; refinement.enough_overlap false: no overlap.
+Verified verifyPose(const Cloud& reference, const Cloud& moving, const RigidTransform& start,
+                    const std::vector<PlaneAnchor>& anchors, const RegistrationParams& quick,
+                    const PoseVerifier& verifier) {
+  Verified v;
+  v.refinement = refinePose(reference, moving, start, anchors, quick, {});
+  if (!v.refinement.enough_overlap) return v;
+  v.evidence = verifier.evaluate(v.refinement.transform);
+  const SurfaceFit fit = surfaceFit(reference, transformCloud(moving, v.refinement.transform), quick.crossed_radius_m,
+                                    quick.uncertainty_m, quick.icp.normal_k, quick.max_icp_points);
+  v.fits = fit.points > 0 && fit.rms_m <= quick.uncertainty_m && fit.inlier_fraction >= quick.min_inlier_fraction &&
+           v.refinement.converged;
+  return v;
+}
+
+// The scene's own symmetries, turned onto a pose: a box room maps onto itself
+// turned 90°, 180° or 270° about a line along one of its axes, so when `lead`
+// is wrong the truth may be lead turned so — and a plane match may never have
+// proposed it (the units saw different walls). For each axis (the reference
+// planes' normals) and turn, the line's position is searched over the reference
+// cloud's extent (0.2 m steps, then 0.04 m); the likeliest turned pose of each comes back.
+std::vector<RigidTransform> symmetricAlternatives(const Cloud& reference, const std::vector<DetectedPlane>& R,
+                                                  const PlaneIndependence& independent, const PoseVerifier& verifier,
+                                                  const RigidTransform& lead, size_t samples) {
+  std::vector<Vec3> axes;
+  for (const DetectedPlane& pl : R) {
+    bool known = false;
+    for (const Vec3& a : axes) known = known || !independent.pair(a, pl.normal);
+    if (!known && axes.size() < 3) axes.push_back(pl.normal);
+  }
+  Vec3 lo = reference.points.front(), hi = lo;
+  for (const Vec3& q : reference.points) {
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  const Vec3 mid = (lo + hi) / 2;
+  const double half = (hi - lo).norm() / 2;
+  std::vector<RigidTransform> out;
+  for (const Vec3& a : axes) {
+    const Vec3 u = a.unitOrthogonal(), v = a.cross(u);
+    for (int quarter = 1; quarter <= 3; ++quarter) {
+      const Eigen::Matrix3d turn = Eigen::AngleAxisd(quarter * M_PI / 2, a).toRotationMatrix();
+      auto posed = [&](const Vec3& c) {
+        RigidTransform t = lead;
+        t.linear() = turn * lead.linear();
+        t.translation() = turn * lead.translation() + (c - turn * c);
+        return t;
+      };
+      Vec3 best_c = mid;
+      double best = -std::numeric_limits<double>::infinity();
+      for (double step : {0.2, 0.04}) {
+        const double span = step == 0.2 ? half : 0.2;
+        const Vec3 centre = best_c;
+        for (double i = -span; i <= span + 1e-9; i += step)
+          for (double j = -span; j <= span + 1e-9; j += step) {
+            const Vec3 c = centre + i * u + j * v;
+            const double ll = verifier.evaluate(posed(c), samples).log_likelihood;
+            if (ll > best) {
+              best = ll;
+              best_c = c;
+            }
+          }
+      }
+      out.push_back(posed(best_c));
+    }
+  }
+  return out;
+}
+
+// The plane method: every hypothesis screened by its likelihood on a few
+// samples, the likeliest refined by ICP and scored on all samples both ways;
+// the best must beat the runner-up (a different pose) by the verifier's margin,
+// else the result is ambiguous and says which poses compete and what decides.
+Refinement choosePlanePose(const Cloud& reference, const Cloud& moving, const RegistrationParams& p,
+                           const Progress& progress, Registration& out) {
+  PlaneDetection dr, dm;
+  std::vector<Hypothesis> hyps = planeHypotheses(reference, moving, p, progress, out, dr, dm);
+  const PoseVerifier verifier(reference, moving, p.verify);
+  // Poses closer than the crossed radius everywhere over the moving cloud are one.
+  double extent = 0;
+  const Vec3 centre = moving.viewpoint.value_or(Vec3::Zero());
+  for (const Vec3& q : moving.points) extent = std::max(extent, (q - centre).norm());
+  // A pose is determined when the planes it lands fix all six degrees of
+  // freedom (normals with an independent triple; a pair with a picked pair):
+  // a pose landing fewer overlaps little and so is contradicted by little,
+  // which is no evidence for it. Determined poses are ranked by their
+  // free-space evidence, then by planes landed.
+  const PlaneIndependence independent{p.match};
+  auto determined = [&](const Hypothesis& h) {
+    std::vector<size_t> landed;
+    for (size_t k = 0; k < h.on.size(); ++k)
+      if (h.on[k] < dr.planes.size()) landed.push_back(k);
+    if (p.pairs.size() == 1) return h.candidate.planes_on >= 2;
+    for (size_t a = 0; a < landed.size(); ++a)
+      for (size_t b = a + 1; b < landed.size(); ++b)
+        for (size_t c = b + 1; c < landed.size(); ++c)
+          if (independent.triple(dm.planes[landed[a]].normal, dm.planes[landed[b]].normal, dm.planes[landed[c]].normal))
+            return true;
+    return false;
+  };
+  for (Hypothesis& h : hyps) {
+    h.screen = verifier.evaluate(h.candidate.transform, p.screen_samples);
+    h.determined = determined(h);
+  }
+  auto rank = [](const Hypothesis& h) { return h.determined; };
+  std::sort(hyps.begin(), hyps.end(), [&](const Hypothesis& a, const Hypothesis& b) {
+    if (rank(a) != rank(b)) return rank(a);
+    if (a.screen.log_likelihood != b.screen.log_likelihood) return a.screen.log_likelihood > b.screen.log_likelihood;
+    if (a.candidate.planes_on != b.candidate.planes_on) return a.candidate.planes_on > b.candidate.planes_on;
+    return a.screen.consistency > b.screen.consistency;
+  });
+  std::vector<Verified> refined;
+  // Candidates are refined on a quarter of the points (the choice needs the
+  // basin, not the last 0.1 mm); the winner is refined again on all of them.
+  RegistrationParams quick = p;
+  quick.max_icp_points = std::max<size_t>(100, p.max_icp_points / 4);
+  // Refined: the screen's best and every pose the screen cannot yet reject
+  // against it (with enough overlap), up to refined_hypotheses; at least two.
+  size_t to_refine = 0;
+  while (to_refine < hyps.size() && to_refine < p.refined_hypotheses &&
+         rank(hyps[to_refine]) && (to_refine < 2 || !verifier.compare(hyps[0].screen, hyps[to_refine].screen).decisive))
+    ++to_refine;
+  if (to_refine == 0)
+    throw AnalysisError("[registerClouds] none of the " + std::to_string(hyps.size()) +
+                        " plane matches lands planes of the moving cloud that fix the pose (three with independent "
+                        "normals on reference planes): the units see too few of the same planes — decide with --pairs, "
+                        "--plane-hints, or a reference cube both units see");
+  for (size_t i = 0; i < to_refine; ++i) {
+    progress("verifying poses", static_cast<double>(i) / static_cast<double>(to_refine));
+    Verified v = verifyPose(reference, moving, hyps[i].candidate.transform,
+                            planeAnchors(moving, hyps[i], dr.planes, dm.planes, quick.max_anchor_points), quick, verifier);
+    v.hypothesis = &hyps[i];
+    if (!v.refinement.enough_overlap) continue;
+    // Two hypotheses ICP brought to one pose are one pose.
+    bool same = false;
+    for (Verified& o : refined) {
+      if (compareTransforms(o.refinement.transform, v.refinement.transform, extent, p.crossed_radius_m).moved)
+        continue;
+      same = true;
+      if (v.evidence.log_likelihood > o.evidence.log_likelihood) o = std::move(v);
+      break;
+    }
+    if (!same) refined.push_back(std::move(v));
+  }
+  // The likeliest so far, turned by the room's symmetries, competes too: the
+  // truth may be one of them when no plane match proposed it.
+  if (!refined.empty() && p.symmetric_alternatives) {
+    const Verified* lead = &refined.front();
+    for (const Verified& v : refined)
+      if (v.fits && (!lead->fits || v.evidence.log_likelihood > lead->evidence.log_likelihood)) lead = &v;
+    const Hypothesis* lead_h = lead->hypothesis;
+    const RigidTransform lead_t = lead->refinement.transform;
+    const std::vector<RigidTransform> alts = symmetricAlternatives(reference, dr.planes, independent, verifier, lead_t,
+                                                                   std::min<size_t>(p.screen_samples, 300));
+    std::vector<std::pair<double, RigidTransform>> ranked;
+    for (const RigidTransform& t : alts) ranked.push_back({verifier.evaluate(t, p.screen_samples).log_likelihood, t});
+    std::sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+    for (size_t k = 0; k < ranked.size() && k < 2; ++k) {
+      Verified v = verifyPose(reference, moving, ranked[k].second, {}, quick, verifier);
+      v.hypothesis = lead_h;
+      if (!v.refinement.enough_overlap) continue;
+      bool same = false;
+      for (const Verified& o : refined)
+        same = same || !compareTransforms(o.refinement.transform, v.refinement.transform, extent, p.crossed_radius_m).moved;
+      if (!same) refined.push_back(std::move(v));
+    }
+  }
+  if (refined.empty())
+    throw AnalysisError("[registerClouds] no overlap: none of the " + std::to_string(hyps.size()) +
+                        " plane alignments leaves " + std::to_string(p.min_overlap_points) +
+                        " points of each cloud within " + formatFixed(p.crossed_radius_m) +
+                        " m of the other; the clouds must see some of the same surfaces");
+  // Poses that fit the overlap first; among them the one the free space contradicts least.
+  std::sort(refined.begin(), refined.end(), [](const Verified& a, const Verified& b) {
+    return a.fits != b.fits ? a.fits : a.evidence.log_likelihood > b.evidence.log_likelihood;
+  });
+  const Verified& best = refined.front();
+  reportPairings(*best.hypothesis, dr.planes, dm.planes, out);
+  out.coarse = best.hypothesis->candidate.transform;
+  out.coarse_overlap_fraction = static_cast<double>(best.evidence.on_surface) /
+                                static_cast<double>(std::max<size_t>(1, best.evidence.per_sample.size()));
+  out.free_space_fraction = static_cast<double>(best.evidence.in_free_space) /
+                            static_cast<double>(std::max<size_t>(1, best.evidence.per_sample.size()));
+  out.poses_verified = refined.size();
+  // Planes landed speak too: a fitting pose that lands as many of them as the
+  // likeliest leaves the choice open whatever the free space says (on the
+  // tunnel fixture without occlusion the free space favours a pose 90° off).
+  const CandidateScorer landing(reference, moving, dr.planes, dm.planes, p.match);
+  for (Verified& v : refined)
+    for (size_t j : landing.landings(v.refinement.transform)) v.planes_on += j < dr.planes.size();
+  for (size_t i = 1; i < refined.size() && !out.ambiguous; ++i)
+    if (refined[i].fits && refined[i].planes_on >= best.planes_on) {
+      out.ambiguous = true;
+      out.warnings.push_back("ambiguous: the likeliest pose, " + describePose(best.refinement.transform) + ", lands " +
+                             std::to_string(best.planes_on) + " planes, and another, " +
+                             describePose(refined[i].refinement.transform) + ", lands " +
+                             std::to_string(refined[i].planes_on) +
+                             " — decide with --pairs, --plane-hints, or a reference cube both units see");
+    }
+  if (!out.ambiguous && refined.size() > 1 && refined[1].fits) {
+    const PoseComparison c = verifier.compare(best.evidence, refined[1].evidence);
+    out.log_likelihood_ratio = c.log_ratio;
+    out.log_likelihood_ratio_needed = c.needed;
+    if (!c.decisive) {
+      out.ambiguous = true;
+      out.warnings.push_back(
+          "ambiguous: " + std::to_string(refined.size()) + " poses fit; the likeliest, " +
+          describePose(best.refinement.transform) + " (" + std::to_string(best.evidence.in_free_space) +
+          " samples in the other unit's free space), beats " + describePose(refined[1].refinement.transform) + " (" +
+          std::to_string(refined[1].evidence.in_free_space) + ") by a log-likelihood ratio of " +
+          formatFixed(c.log_ratio, 1) + " where " + formatFixed(c.needed, 1) +
+          " is needed — decide with --pairs, --plane-hints, or a reference cube both units see");
+    }
+  }
+  if (!p.refine) return best.refinement;
+  return refinePose(reference, moving, best.refinement.transform,
+                    planeAnchors(moving, *best.hypothesis, dr.planes, dm.planes, p.max_anchor_points), p, progress);
+}
+
 }  // namespace
 
 RigidTransform transformFromPlanes(const DetectedPlane (&reference)[3], const DetectedPlane (&moving)[3]) {
@@ -449,58 +740,49 @@ Registration registerClouds(const Cloud& reference, const Cloud& moving, const R
   checkParams(reference, moving, p);
   Registration out;
   out.method = p.method;
-  RigidTransform coarse = RigidTransform::Identity();
-  std::vector<PlaneAnchor> anchors;
+  Refinement refinement;
   if (p.method == "planes") {
-    coarse = planeAlignment(reference, moving, p, progress, out, anchors);
-  } else if (p.method == "svd") {
-    const KabschFit fit = fitKabsch(p.pairs);
-    coarse = fit.transform;
-    if (fit.reflection_corrected)
-      out.warnings.push_back("the picked pairs fit a reflection best; the nearest rotation was used — check the pairs");
-    if (fit.rms_m > p.uncertainty_m)
-      out.warnings.push_back("picked pairs disagree by " + formatFixed(fit.rms_m * 1000, 1) + " mm RMS, above the " +
-                             formatFixed(p.uncertainty_m * 1000, 1) + " mm uncertainty (picking error)");
+    refinement = choosePlanePose(reference, moving, p, progress, out);
   } else {
-    // Plain ICP from the raw pose: wide correspondences over both whole clouds.
-    IcpParams ip = p.icp;
-    ip.method = "point-to-point";
-    ip.max_correspondence_m = p.icp_initial_correspondence_m;
-    const Cloud ref_sub = selectPoints(reference, thin(allIndices(reference.size()), p.max_icp_points));
-    const Cloud mov_sub = selectPoints(moving, thin(allIndices(moving.size()), p.max_icp_points));
-    const IcpResult icp = refineIcp(ref_sub, mov_sub, p.initial, ip, progress);
-    for (const auto& w : icp.warnings) out.warnings.push_back("plain ICP: " + w);
-    coarse = icp.transform;
+    RigidTransform coarse = RigidTransform::Identity();
+    if (p.method == "svd") {
+      const KabschFit fit = fitKabsch(p.pairs);
+      coarse = fit.transform;
+      if (fit.reflection_corrected)
+        out.warnings.push_back("the picked pairs fit a reflection best; the nearest rotation was used — check the pairs");
+      if (fit.rms_m > p.uncertainty_m)
+        out.warnings.push_back("picked pairs disagree by " + formatFixed(fit.rms_m * 1000, 1) + " mm RMS, above the " +
+                               formatFixed(p.uncertainty_m * 1000, 1) + " mm uncertainty (picking error)");
+    } else {
+      // Plain ICP from the raw pose: wide correspondences over both whole clouds.
+      IcpParams ip = p.icp;
+      ip.method = "point-to-point";
+      ip.max_correspondence_m = p.icp_initial_correspondence_m;
+      const Cloud ref_sub = selectPoints(reference, thin(allIndices(reference.size()), p.max_icp_points));
+      const Cloud mov_sub = selectPoints(moving, thin(allIndices(moving.size()), p.max_icp_points));
+      const IcpResult icp = refineIcp(ref_sub, mov_sub, p.initial, ip, progress);
+      for (const auto& w : icp.warnings) out.warnings.push_back("plain ICP: " + w);
+      coarse = icp.transform;
+    }
+    out.coarse = coarse;
+    refinement = refinePose(reference, moving, coarse, {}, p, progress);
   }
-  out.coarse = coarse;
-
   // Crossed filter: only the overlap can hold right correspondences.
-  const CrossedFilter overlap = crossedFilter(reference, transformCloud(moving, coarse), p.crossed_radius_m);
+  const CrossedFilter& overlap = refinement.overlap;
   out.overlap_reference_points = overlap.reference.size();
   out.overlap_moving_points = overlap.moving.size();
-  if (overlap.moving.size() < p.min_overlap_points || overlap.reference.size() < p.min_overlap_points)
+  if (!refinement.enough_overlap)
     throw AnalysisError("[registerClouds] no overlap: after the " + p.method + " alignment only " +
                         std::to_string(overlap.moving.size()) + " moving and " +
                         std::to_string(overlap.reference.size()) + " reference points have a point of the other cloud within " +
                         formatFixed(p.crossed_radius_m) + " m (need " + std::to_string(p.min_overlap_points) +
                         "); the clouds must see some of the same surfaces");
+  for (const auto& w : refinement.warnings) out.warnings.push_back(w);
   const Cloud mov_overlap = selectPoints(moving, overlap.moving);
-  out.before_refinement = nearestDistanceStats(reference, transformCloud(mov_overlap, coarse));
-
-  const Cloud ref_sub = selectPoints(reference, thin(overlap.reference, p.max_icp_points));
-  const Cloud mov_sub = selectPoints(moving, thin(overlap.moving, p.max_icp_points));
-  RigidTransform final_t = coarse;
-  out.converged = true;
-  if (p.refine) {
-    IcpParams ip = p.icp;
-    ip.max_correspondence_m = std::min(ip.max_correspondence_m, p.crossed_radius_m);
-    const IcpResult icp =
-        refineIcp(ref_sub, mov_sub, coarse, ip, progress, ip.method == "point-to-plane" ? anchors : std::vector<PlaneAnchor>{});
-    for (const auto& w : icp.warnings) out.warnings.push_back("refinement: " + w);
-    out.icp_iterations = icp.iterations;
-    out.converged = icp.converged;
-    final_t = icp.transform;
-  }
+  out.before_refinement = nearestDistanceStats(reference, transformCloud(mov_overlap, out.coarse));
+  out.icp_iterations = refinement.iterations;
+  out.converged = refinement.converged;
+  const RigidTransform final_t = refinement.transform;
   out.transform = final_t;
   out.rotation = final_t.linear();
   out.translation = final_t.translation();
@@ -521,6 +803,7 @@ Registration registerClouds(const Cloud& reference, const Cloud& moving, const R
   out.accepted = out.below_uncertainty && out.inlier_fraction >= p.min_inlier_fraction && out.converged && !out.ambiguous;
   return out;
 }
+
 
 Drift compareTransforms(const RigidTransform& stored, const RigidTransform& fresh, double radius_m,
                         double max_displacement_m) {

@@ -12,6 +12,7 @@
 #include "analysis/core/cloud.hpp"
 #include "analysis/core/progress.hpp"
 #include "analysis/registration/icp.hpp"
+#include "analysis/registration/pose_verification.hpp"
 #include "analysis/registration/rigid_transform.hpp"
 #include "analysis/segmentation/plane_detection.hpp"
 
@@ -21,13 +22,7 @@ struct PlaneMatchParams {
   double max_angle_mismatch_deg = 3.0;  // angles between plane normals must agree this well in both clouds
   double min_plane_angle_deg = 30.0;    // planes used together are at least this far from parallel
   double min_triple_det = 0.25;         // |det| of the three unit normals whose intersection gives the translation
-  size_t verify_samples = 2000;         // moving points that score each candidate match
-  double verify_radius_m = 0.05;        // a sample counts when a reference point lies this close
-  // A second, different match that lands as many planes and brings at least
-  // this fraction of the best's sampled points near the reference makes the
-  // result ambiguous (never accepted). 0: any tie on planes — overlap alone is
-  // weak evidence, since a symmetric chamber turned end for end overlaps itself.
-  double ambiguity_ratio = 0.0;
+  double verify_radius_m = 0.05;        // a moving plane's sample lands when a reference plane point lies this close
 };
 
 struct RegistrationParams {
@@ -50,6 +45,17 @@ struct RegistrationParams {
   // planes + point-to-plane refinement: points of each matched moving plane
   // (evenly spread) held to its reference plane alongside the overlap pairs.
   size_t max_anchor_points = 5'000;
+  // planes: every pose the matched planes allow is screened by the verifier on
+  // this many samples of each cloud; the best and those the screen cannot reject
+  // against it (at most `refined_hypotheses`) are refined by ICP and scored on
+  // all its samples, and the best must beat the runner-up by the verifier's
+  // margin (else ambiguous).
+  PoseVerificationParams verify;
+  size_t screen_samples = 1500;
+  size_t refined_hypotheses = 8;
+  // The likeliest pose turned by the room's symmetries (90°, 180°, 270° about
+  // each plane axis, the line placed where the data fit best) competes too.
+  bool symmetric_alternatives = true;
   // Sensor uncertainty the fitness must stay under: σ + systematic error at model
   // scale (SPEC §4 step 4: 9 mm; 14 mm at full scale).
   double uncertainty_m = 0.009;
@@ -76,10 +82,15 @@ struct Registration {
 
   // Plane method.
   size_t reference_planes = 0, moving_planes = 0;
-  std::vector<PlanePairing> pairings;  // first, second, third plane
-  size_t candidates = 0;               // matches scored
-  double coarse_overlap_fraction = 0;  // of the verification samples near the reference
+  std::vector<PlanePairing> pairings;  // every moving plane the chosen pose lands on a reference plane
+  size_t candidates = 0;               // plane matches found
+  size_t poses_verified = 0;           // distinct refined poses the verifier compared
+  double coarse_overlap_fraction = 0;  // of the best pose's verification samples on the other cloud's surface
+  double free_space_fraction = 0;      // of them in the other unit's free space
   size_t coarse_planes_on = 0;         // moving planes that land on a reference plane of the same orientation
+  // The best pose's log-likelihood over the runner-up's (0 with one pose) and the
+  // margin the verifier asks for; ambiguous when it falls short.
+  double log_likelihood_ratio = 0, log_likelihood_ratio_needed = 0;
   bool ambiguous = false;
 
   // Overlap after the coarse alignment (crossed filter), and the distances from

@@ -165,3 +165,63 @@ TEST(Calibration, BadInput) {
   targets[0].radius_m = 0;
   EXPECT_THROW(calibrateUnit(targets, {}), InvalidInput);
 }
+
+TEST(Calibration, AWholeRoomTakenForOnePlaneIsRefusedNotFitted) {
+  // Wall and floor handed over as one "plane" (the whole tunnel, which
+  // fitted p = 10 m with 1 m RMS and exit 0): residuals far above SPEC §3's σ.
+  auto targets = emulatedTargets(room(), -160, 70);
+  CalibrationTarget both = targets[0];
+  both.name = "wall and floor";
+  both.samples.insert(both.samples.end(), targets[1].samples.begin(), targets[1].samples.end());
+  const CalibrationResult bad = calibrateUnit({both}, {});
+  EXPECT_FALSE(bad.plausible);
+  EXPECT_GT(bad.targets[0].rms_m, 2 * 0.004);
+  ASSERT_FALSE(bad.warnings.empty());
+  EXPECT_NE(bad.warnings.back().find("wall and floor"), std::string::npos);
+  EXPECT_NE(bad.warnings.back().find("not usable"), std::string::npos);
+  // The two planes given apart fit within the noise (cloth, σ = 4.1 mm).
+  const CalibrationResult good = calibrateUnit(targets, {});
+  EXPECT_TRUE(good.plausible);
+  CalibrationParams cp;
+  cp.max_rms_sigmas = 0;
+  EXPECT_THROW(calibrateUnit(targets, cp), InvalidInput);
+}
+
+TEST(RangeScale, ParallelFacesOfKnownSpanGiveTheSystematicRangeError) {
+  // A 3.6 m wide, 2.4 m high tunnel seen from inside by a unit whose ranges
+  // read 0.25 % long (SPEC §3: up to ≈ 0.3 %), with noise: the scale comes back
+  // to within its standard error and, taken out, the spans to within the noise.
+  Scene tunnel;
+  tunnel.objects = makeChamber(Vec3(-6, -1.5, -1.0), Vec3(6, 2.1, 1.4));
+  SensorModelParams sp;
+  sp.systematic_fraction = 0.0025;
+  const EmulatedSensor sensor(tunnel, sp);
+  std::mt19937_64 rng(7);
+  std::vector<Vec3> port, starboard, floor, ceiling;
+  for (double beta = -180; beta < 180; beta += 1)
+    for (double a = -60; a <= 60; a += 0.5) {
+      const double ar = a * kRadPerDeg, br = beta * kRadPerDeg;
+      const Vec3 dir(std::cos(ar), std::sin(ar) * std::cos(br), std::sin(ar) * std::sin(br));
+      const BeamReturn b = sensor.measure(Vec3::Zero(), dir, rng);
+      if (b.status != ReturnStatus::Valid || b.mixed) continue;
+      const Vec3 x = b.range_m * dir;
+      const std::string& name = tunnel.objects[b.object].name;
+      if (std::abs(x.x()) > 3) continue;  // away from the end walls' corners
+      if (name == "wall_port") port.push_back(x);
+      if (name == "wall_starboard") starboard.push_back(x);
+      if (name == "floor") floor.push_back(x);
+      if (name == "ceiling") ceiling.push_back(x);
+    }
+  const RangeScaleFit k = fitRangeScale({{"width", port, starboard, 3.6}, {"height", floor, ceiling, 2.4}});
+  EXPECT_NEAR(k.scale, 1.0025, 3e-4);
+  EXPECT_LT(k.residual_rms_m, 0.002);
+  ASSERT_EQ(k.measured_m.size(), 2u);
+  EXPECT_NEAR(k.measured_m[0], 3.6 * 1.0025, 0.003);
+  Cloud c;
+  c.points = {Vec3(0, 1.5 * 1.0025, 0)};
+  EXPECT_NEAR(removeRangeScale(c, k.scale).points[0].y(), 1.5, 0.001);
+  EXPECT_THROW(fitRangeScale({}), InvalidInput);
+  EXPECT_THROW(fitRangeScale({{"bad", port, starboard, 0}}), InvalidInput);
+  EXPECT_THROW(fitRangeScale({{"crossed", port, floor, 3.0}}), InvalidInput);
+  EXPECT_THROW(removeRangeScale(c, 0), InvalidInput);
+}
