@@ -345,6 +345,7 @@ std::vector<std::pair<uint16_t, double>> assemblePoints(const Streamed& streamed
 // The sweep's cloud from its points (SPEC §2 and the unit's pose), with the lost lines' β.
 void buildCloud(const UnitConfig& unit, const std::vector<std::pair<uint16_t, double>>& line_beta_deg, Sweep& sweep) {
   sweep.cloud.viewpoint = unit.pose.translation();
+  sweep.cloud.scanner_range_m = scannerSpec(unit.model).max_range_m;
   sweep.cloud.lost_beta_rad = lostLineBetas(line_beta_deg);
   sweep.cloud.points.reserve(sweep.points.size());
   for (const SweepPoint& p : sweep.points) {

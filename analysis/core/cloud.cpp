@@ -40,6 +40,7 @@ Cloud selectPoints(const Cloud& cloud, const std::vector<uint32_t>& indices) {
   copyAt(cloud.alpha_rad, indices, out.alpha_rad);
   copyAt(cloud.beta_rad, indices, out.beta_rad);
   out.viewpoint = cloud.viewpoint;
+  out.scanner_range_m = cloud.scanner_range_m;
   out.lost_beta_rad = cloud.lost_beta_rad;
   return out;
 }

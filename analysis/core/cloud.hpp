@@ -17,6 +17,10 @@ struct Cloud {
   std::vector<double> alpha_rad;       // scanner mirror angle α of each sample (SPEC §2)
   std::vector<double> beta_rad;        // turntable angle β of each sample
   std::optional<Vec3> viewpoint;       // scanner origin, same frame as points
+  // The range of the scanner that took the samples (SPEC §3: 20 m for the LMS111, 80 m
+  // for the LMS511), m; 0: unknown. Where the samples stop at it, the scan ran out of
+  // range there, whatever lay beyond.
+  double scanner_range_m = 0;
   // Turntable angles β of the scan lines the sweep lost (the scanner counted them and
   // none arrived), ascending, each at its line's middle beam. An edge beside one may lie
   // a line spacing further out than the samples say.

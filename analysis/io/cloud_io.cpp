@@ -88,13 +88,14 @@ class CloudBuilder {
   }
 
   CloudReadResult finish(const std::string& path, std::string format, const std::optional<Vec3>& viewpoint,
-                         std::vector<double> lost_beta_rad = {}) {
+                         std::vector<double> lost_beta_rad = {}, double scanner_range_m = 0) {
     if (seen_ == 0) throw fileError(path, "no points");
     if (cloud_.empty())
       throw fileError(path, "no finite points (all " + std::to_string(seen_) + " points have NaN coordinates)");
     CloudReadResult result;
     cloud_.viewpoint = viewpoint;
     cloud_.lost_beta_rad = std::move(lost_beta_rad);
+    cloud_.scanner_range_m = scanner_range_m;
     result.cloud = std::move(cloud_);
     result.format = std::move(format);
     result.dropped_nan_points = dropped_;
@@ -217,7 +218,7 @@ CloudReadResult readPly(const std::string& path, const std::string& buf) {
   if (header.encoding == PlyEncoding::Ascii) {
     CloudBuilder builder(present, reserveFor(vertex.count, bytes_left, 2 * vertex.properties.size()));
     readPlyAsciiVertices(path, buf, header, vertex_index, roles, builder);
-    return builder.finish(path, "ply-ascii", header.viewpoint, header.lost_beta_rad);
+    return builder.finish(path, "ply-ascii", header.viewpoint, header.lost_beta_rad, header.scanner_range_m);
   }
 
   const bool file_little = header.encoding == PlyEncoding::BinaryLittleEndian;
@@ -226,7 +227,7 @@ CloudReadResult readPly(const std::string& path, const std::string& buf) {
   for (size_t e = 0; e < vertex_index; ++e) pos = skipBinaryElement(path, buf, pos, header.elements[e], swap);
   CloudBuilder builder(present, reserveFor(vertex.count, buf.size() - pos, vertex.fixedSize()));
   readPlyBinaryVertices(path, buf, pos, swap, vertex, roles, builder);
-  return builder.finish(path, "ply-binary", header.viewpoint, header.lost_beta_rad);
+  return builder.finish(path, "ply-binary", header.viewpoint, header.lost_beta_rad, header.scanner_range_m);
 }
 
 // ---------------------------------------------------------------------------
@@ -662,6 +663,11 @@ std::string plyContent(const Cloud& cloud, const Columns& c, bool binary) {
   if (cloud.viewpoint) {
     out += "comment viewpoint";
     appendViewpointNumbers(out, *cloud.viewpoint);
+    out += '\n';
+  }
+  if (cloud.scanner_range_m > 0) {
+    out += "comment scanner_range_m ";
+    appendNumber(out, cloud.scanner_range_m);
     out += '\n';
   }
   // Ten to a line: a long sweep may lose many.

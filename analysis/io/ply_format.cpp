@@ -81,6 +81,10 @@ PlyHeader parsePlyHeader(const std::string& path, const std::string& buf) {
     } else if (key == "comment") {
       if (auto v = viewpointComment(tok, 1)) header.viewpoint = v;
       if (auto b = lostBetaComment(tok, 1)) header.lost_beta_rad.insert(header.lost_beta_rad.end(), b->begin(), b->end());
+      double range = 0;
+      if (tok.size() == 3 && tok[1] == "scanner_range_m" && parseNumber(tok[2], range) == Parsed::Ok &&
+          std::isfinite(range) && range > 0)
+        header.scanner_range_m = range;
     } else if (key == "obj_info") {
       continue;
     } else if (key == "element") {

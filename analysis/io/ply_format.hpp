@@ -126,6 +126,7 @@ struct PlyHeader {
   std::vector<PlyElement> elements;
   std::optional<Vec3> viewpoint;  // from a "comment viewpoint X Y Z" line
   std::vector<double> lost_beta_rad;  // from "comment lost_beta_rad B1 B2 ..." lines
+  double scanner_range_m = 0;         // from a "comment scanner_range_m R" line (0: none)
   size_t data_offset = 0;         // first byte after "end_header\n"
   size_t end_header_line = 0;     // line number of end_header
 };

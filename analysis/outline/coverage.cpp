@@ -94,6 +94,20 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
   std::nth_element(angular.begin(), angular.begin() + static_cast<long>(n / 2), angular.end());
   const double cell = std::max(1e-5, angular[n / 2]);
   const DirectionMap seen(scene, scanner, cell);
+  // The scene less the mesh's own samples and those beside them (three spacings): a
+  // return among these at the sail's range, beyond its boundary, is more sail the mesh
+  // does not hold. Seen obliquely, the mesh's own edge lies in the same directions.
+  std::vector<Vec3> apart;
+  {
+    std::vector<uint32_t> idx;
+    std::vector<double> d2;
+    const double near2 = std::pow(3.0 * loop.spacing, 2);
+    for (const Vec3& q : scene) {
+      samples.tree.nearest(q, 1, idx, d2);
+      if (d2.empty() || d2[0] > near2) apart.push_back(q);
+    }
+  }
+  const DirectionMap beyond_mesh(apart, scanner, cell);
   for (size_t i = 0; i < n; ++i) {
     Vec3 normal = Vec3::Zero();
     const Vec3 ref = samples.normals[loop.vertex[i]];
@@ -111,30 +125,36 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
     if (s.stop != Stop::Edge || scene.empty()) continue;
     // Two spacings beyond the boundary, outwards across it on the surface: the beam
     // there met something standing clear of the sail (ten spacings nearer the scanner,
-    // beyond the sail's own samples around it) — a spar, a stay, another sail.
+    // beyond the sail's own samples around it: a spar, a stay, another sail).
     const Vec3 tangent = loop.points[(i + 1) % n] - loop.points[(i + n - 1) % n];
     Vec3 out = tangent.cross(normal.dot(loop.normal) < 0 ? Vec3(-normal) : normal);
     if (out.norm() < 1e-12) continue;
     out.normalize();
-    auto blocked = [&](double beyond_m, double& in_the_way) {
+    enum class Beam { Clear, Blocked, Sail };
+    auto probe = [&](double beyond_m, double& met) {
       const Vec3 to = loop.points[i] + beyond_m * out - scanner;
-      in_the_way = seen.nearest(to.normalized());
-      return in_the_way < to.norm() - 10.0 * loop.spacing;
+      met = seen.nearest(to.normalized());
+      if (met < to.norm() - 10.0 * loop.spacing) return Beam::Blocked;
+      const double other = beyond_mesh.nearest(to.normalized());
+      return other < to.norm() + 10.0 * loop.spacing ? Beam::Sail : Beam::Clear;
     };
-    double in_the_way = 0;
-    if (!blocked(2.0 * loop.spacing, in_the_way)) continue;
-    // A narrow shadow (a stay, a mast seen beside a sail's head) ends within the corner's
-    // neighbourhood: beyond it the beams meet nothing nearer, and no sail either (the
-    // boundary would run there otherwise), so the edge lies within the shadow's width.
+    double met = 0;
+    if (probe(2.0 * loop.spacing, met) != Beam::Blocked) continue;
+    // A narrow shadow (a stay, a mast seen beside a sail's head) that ends within the
+    // corner's neighbourhood, beyond which the beams meet neither anything nearer nor
+    // more of the scene off the mesh where the sail would go on (a strip of it cut off
+    // by the shadow), holds the edge within its width.
     s.stop = Stop::Shadow;
-    s.shadow_range_m = in_the_way;
-    double unused = 0;
-    for (double w = 3.0 * loop.spacing; w <= around; w += loop.spacing)
-      if (!blocked(w, unused)) {
+    s.shadow_range_m = met;
+    for (double w = 3.0 * loop.spacing; w <= around; w += loop.spacing) {
+      const Beam beam = probe(w, met);
+      if (beam == Beam::Blocked) continue;
+      if (beam == Beam::Clear) {
         s.stop = Stop::Edge;
         s.bracket_m = w;
-        break;
       }
+      break;
+    }
   }
   return stops;
 }

@@ -417,7 +417,10 @@ void outlineSail(const Cloud& input, const Cloud& sail_scan, const std::vector<V
     loose.insert(loose.end(), scan_points.begin(), scan_points.end());
     sample_density = static_cast<double>(a.sail_points) / std::max(1e-12, meshArea(a.mesh));
   }
-  a.outline = extractOutline(a.mesh, p.outline, loose, sample_density, input.viewpoint, scene);
+  // A scan that says which scanner took it tells where it ran out of range.
+  OutlineParams op = p.outline;
+  if (op.scanner_max_range_m == 0) op.scanner_max_range_m = input.scanner_range_m;
+  a.outline = extractOutline(a.mesh, op, loose, sample_density, input.viewpoint, scene);
   for (std::string& w : widenCornersBesideLostLines(a.outline, sail_scan)) a.outline.warnings.push_back(std::move(w));
   a.luff = measureLuffCurve(a.outline);
   t.finish(a.outline.boundary.size(), a.outline.warnings);

@@ -24,6 +24,7 @@
 #include "database/schema.hpp"
 #include "database/sqlite.hpp"
 #include "tests/cli/run_sailshape.hpp"
+#include "tests/database/pg_cluster.hpp"
 
 namespace fs = std::filesystem;
 using sailshape::testing::Outcome;
@@ -284,6 +285,32 @@ TEST_F(DemoRun, WritesAReadableReportPerSail) {
     const std::string text = runCommand("pdftotext '" + pdf.string() + "' - 2>/dev/null");
     EXPECT_NE(text.find("A2 tack ease"), std::string::npos);
   }
+}
+
+// The loft's shared store (issue 38): the demo's database copied to a PostgreSQL server
+// gives the same trim report, read from the server, as from the file (pdftotext's words,
+// the creation date aside).
+TEST_F(DemoRun, AReportReadFromAPostgreSQLCopyOfTheDemoIsTheSame) {
+  ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
+  std::string url;
+  try {
+    url = sailshape::test::PgCluster::shared().createDatabase();
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
+  const std::string db = (dir_ / "out" / "sailshape.db").string();
+  Outcome o = runSailshape(dir_, "db copy '" + db + "' '" + url + "'");
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  std::string texts[2];
+  const std::string sources[2] = {db, url};
+  for (int k = 0; k < 2; ++k) {
+    const fs::path pdf = dir_ / ("scan1-" + std::to_string(k) + ".pdf");
+    o = runSailshape(dir_, "report --db '" + sources[k] + "' --scan 1 --out '" + pdf.string() + "' --quiet");
+    ASSERT_EQ(o.exit_code, 0) << sources[k] << ": " << o.err;
+    texts[k] = runCommand("pdftotext '" + pdf.string() + "' - 2>/dev/null");
+  }
+  EXPECT_GT(texts[0].size(), 1000u);
+  EXPECT_EQ(texts[0], texts[1]);
 }
 
 TEST(DemoCommand, RefusesToOverwriteAnEarlierRun) {

@@ -81,8 +81,9 @@ Scan sweepScene(const Config& c, const Scene& scene, int threads) {
     scan.object.insert(scan.object.end(), l.object.begin(), l.object.end());
     for (size_t s = 0; s < 5; ++s) scan.sail_beams[s] += l.sail_beams[s];
   }
-  // The viewpoint sailshape's sweeps write (acquisition/sweep.cpp): the unit's position.
+  // The viewpoint and range sailshape's sweeps write (acquisition/sweep.cpp): the unit's position, its model's range.
   cloud.viewpoint = pose.translation();
+  cloud.scanner_range_m = sensor.spec().max_range_m;
   return scan;
 }
 

@@ -270,6 +270,27 @@ TEST_F(CloudIoTest, PlyKeepsTheSweepsLostScanLines) {
   EXPECT_EQ(r.cloud.lost_beta_rad, (std::vector<double>{0.2}));
 }
 
+// The scanner's range travels with sailshape's PLY (a scan that stops at it ran out of
+// range there), through a crop too; a malformed comment is only a comment.
+TEST_F(CloudIoTest, PlyKeepsTheScannersRange) {
+  Cloud cloud = makeCloud(20, true);
+  cloud.scanner_range_m = 20.0;  // an LMS111 (SPEC §3)
+  for (const CloudFormat f : {CloudFormat::PlyAscii, CloudFormat::PlyBinary}) {
+    const std::string p = path(f == CloudFormat::PlyAscii ? "a.ply" : "b.ply");
+    writeCloud(p, cloud, f);
+    const CloudReadResult r = readCloud(p);
+    EXPECT_EQ(r.cloud.scanner_range_m, 20.0);
+    EXPECT_EQ(selectPoints(r.cloud, {3, 4}).scanner_range_m, 20.0);
+  }
+  cloud.scanner_range_m = 0;
+  writeCloud(path("c.ply"), cloud);
+  EXPECT_EQ(readCloud(path("c.ply")).cloud.scanner_range_m, 0.0);
+  const CloudReadResult odd = readCloud(
+      write("odd.ply", "ply\nformat ascii 1.0\ncomment scanner_range_m far\n"
+                       "element vertex 1\nproperty double x\nproperty double y\nproperty double z\nend_header\n1 2 3\n"));
+  EXPECT_EQ(odd.cloud.scanner_range_m, 0.0);
+}
+
 TEST_F(CloudIoTest, PlyAllScalarTypeNames) {
   Bytes b;
   b.text(
