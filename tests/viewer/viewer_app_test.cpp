@@ -14,6 +14,7 @@
 #include <string>
 
 #include "database/scan_record.hpp"
+#include "tests/database/pg_cluster.hpp"
 #include "viewer/catalog_tree.hpp"
 #include "viewer_fixture.hpp"
 
@@ -181,11 +182,10 @@ TEST_F(ViewerApp, DeviationColoursAndSurvivingResizeAndMinimise) {
 
 // Live mode as scripted by --live: an emulated deck unit sweeps until two sweeps are analysed, every sweep is
 // stored, and the view, from the unit (--camera unit), shows the last one's sail cluster (--show) against the design.
-TEST_F(ViewerApp, LiveModeShowsEachAnalysedSweepAndStoresIt) {
-  const std::string db = dir_->file("live.sqlite");
+void expectLiveModeShowsEachAnalysedSweepAndStoresIt(const test::TempDir& dir, const std::string& db) {
   { Database created = openSailDatabase(db); }
-  const std::string png = dir_->file("live.png");
-  const ViewerRun r = runViewer(*dir_, quote(db) + " --live 2 --camera unit --show design,cluster,sections,design-sections --screenshot " +
+  const std::string png = dir.file("live.png");
+  const ViewerRun r = runViewer(dir, quote(db) + " --live 2 --camera unit --show design,cluster,sections,design-sections --screenshot " +
                                            quote(png) + " --frames 3");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   int swept = 0, analysed = 0, failed = 0;
@@ -221,6 +221,22 @@ TEST_F(ViewerApp, LiveModeShowsEachAnalysedSweepAndStoresIt) {
   size_t with_sections = 0;
   for (int64_t id : tree.scanIds()) with_sections += loadScanRecord(stored, id).sections.sections.size() == 2;
   EXPECT_EQ(with_sections, static_cast<size_t>(analysed)) << "each analysed sweep with its two sections";
+}
+
+TEST_F(ViewerApp, LiveModeShowsEachAnalysedSweepAndStoresIt) {
+  expectLiveModeShowsEachAnalysedSweepAndStoresIt(*dir_, dir_->file("live.sqlite"));
+}
+
+// The same into the loft's shared store (issue 38): the viewer opens a PostgreSQL URL and
+// live mode stores every sweep there.
+TEST_F(ViewerApp, LiveModeStoresIntoAPostgreSQLStore) {
+  std::string url;
+  try {
+    url = sailshape::test::PgCluster::shared().createDatabase();
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
+  expectLiveModeShowsEachAnalysedSweepAndStoresIt(*dir_, url);
 }
 
 TEST_F(ViewerApp, OpensAnEmptyDatabase) {
