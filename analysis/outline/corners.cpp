@@ -129,13 +129,13 @@ NamedCorners findCorners(const BoundaryLoop& loop, const OutlineParams& p) {
   return corners;
 }
 
-std::vector<Vec3> walkBetween(const BoundaryLoop& loop, const NamedCorners& corners, size_t from, size_t to) {
+std::vector<size_t> indicesBetween(const BoundaryLoop& loop, const NamedCorners& corners, size_t from, size_t to) {
   const size_t n = loop.size();
-  for (int dir : {1, -1}) {
-    std::vector<Vec3> line{loop.points[from]};
+  for (size_t dir : {size_t{1}, n - 1}) {
+    std::vector<size_t> line{from};
     bool blocked = false;
-    for (size_t i = (from + n + dir) % n;; i = (i + n + dir) % n) {
-      line.push_back(loop.points[i]);
+    for (size_t i = (from + dir) % n;; i = (i + dir) % n) {
+      line.push_back(i);
       if (i == to) break;
       if (std::find(corners.picked.begin(), corners.picked.end(), i) != corners.picked.end()) {
         blocked = true;
@@ -144,7 +144,15 @@ std::vector<Vec3> walkBetween(const BoundaryLoop& loop, const NamedCorners& corn
     }
     if (!blocked) return line;
   }
-  throw AnalysisError("[extractOutline] corners are not in sail order along the boundary");
+  return {};
+}
+
+std::vector<Vec3> walkBetween(const BoundaryLoop& loop, const NamedCorners& corners, size_t from, size_t to) {
+  const std::vector<size_t> idx = indicesBetween(loop, corners, from, to);
+  if (idx.empty()) throw AnalysisError("[extractOutline] corners are not in sail order along the boundary");
+  std::vector<Vec3> line;
+  for (size_t i : idx) line.push_back(loop.points[i]);
+  return line;
 }
 
 }  // namespace sailshape::outline_internal

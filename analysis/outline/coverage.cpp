@@ -38,7 +38,7 @@ struct BoundaryStop {
 // towards direction u met nothing nearer than nearest(u) (within a cell each way).
 class DirectionMap {
  public:
-  DirectionMap(const std::vector<Vec3>& points, const Vec3& scanner, double cell) : scanner_(scanner), cell_(cell) {
+  DirectionMap(const std::vector<Vec3>& points, const Vec3& scanner, double cell) : cell_(cell) {
     for (const Vec3& p : points) {
       const Vec3 d = p - scanner;
       const double r = d.norm();
@@ -71,7 +71,6 @@ class DirectionMap {
   }
   uint64_t key(const Vec3& u) const { return pack(index(u)); }
 
-  Vec3 scanner_;
   double cell_;
   std::unordered_map<uint64_t, double> nearest_;
 };
@@ -157,25 +156,6 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
     }
   }
   return stops;
-}
-
-// The loop indices from corner `from` to corner `to`, the way that passes no other corner.
-std::vector<size_t> indicesBetween(const BoundaryLoop& loop, const NamedCorners& c, size_t from, size_t to) {
-  const size_t n = loop.size();
-  for (size_t dir : {size_t{1}, n - 1}) {
-    std::vector<size_t> line{from};
-    bool blocked = false;
-    for (size_t i = (from + dir) % n;; i = (i + dir) % n) {
-      line.push_back(i);
-      if (i == to) break;
-      if (std::find(c.picked.begin(), c.picked.end(), i) != c.picked.end()) {
-        blocked = true;
-        break;
-      }
-    }
-    if (!blocked) return line;
-  }
-  return {};
 }
 
 double edgeFraction(const std::vector<BoundaryStop>& stops, const std::vector<size_t>& idx) {

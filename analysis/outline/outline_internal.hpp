@@ -65,7 +65,10 @@ struct NamedCorners {
 };
 NamedCorners findCorners(const BoundaryLoop& loop, const OutlineParams& params);
 
-// The loop's points from corner `from` to corner `to`, the way that passes no other corner.
+// The loop's indices from corner `from` to corner `to`, the way that passes no other
+// corner (empty when both ways do).
+std::vector<size_t> indicesBetween(const BoundaryLoop& loop, const NamedCorners& corners, size_t from, size_t to);
+// Their points; throws AnalysisError when both ways pass another corner.
 std::vector<Vec3> walkBetween(const BoundaryLoop& loop, const NamedCorners& corners, size_t from, size_t to);
 
 // ---- edges.cpp: the edge model ----
