@@ -169,11 +169,23 @@ void migrateSchema(Database& db, int target_version) {
 
 Database openSailDatabase(const std::string& path, const OpenOptions& options) {
   Database db(path, options);
-  const int version = db.userVersion();
+  // Version and table count from one snapshot: another opener may be migrating,
+  // and tables read after a version of 0 may be its, not a foreign application's.
+  db.beginSnapshot();
+  int version = 0;
+  int64_t tables = 0;
+  try {
+    version = db.userVersion();
+    tables = db.tableCount();
+    db.commit();
+  } catch (...) {
+    db.rollback();
+    throw;
+  }
   if (version > kSchemaVersion)
     throw DatabaseError("[openSailDatabase] " + db.path() + ": database schema version " + std::to_string(version) +
                         " is newer than this sailshape (" + std::to_string(kSchemaVersion) + ")");
-  if (version == 0 && db.tableCount() > 0)
+  if (version == 0 && tables > 0)
     throw DatabaseError("[openSailDatabase] " + db.path() + ": " +
                         (db.backend() == Backend::SQLite ? "an SQLite database" : "a PostgreSQL database") +
                         " of another application (tables but no sailshape schema); left untouched");

@@ -3,7 +3,9 @@
 #include <sqlite3.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
+#include <thread>
 #include <utility>
 
 namespace sailshape::detail {
@@ -121,9 +123,7 @@ class SqliteConnection : public ConnectionBackend {
   void rollback() noexcept override { sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr); }
   void beginSnapshot() override { exec("BEGIN"); }
   void lockSchema(bool) override {}
-  void enableConcurrentReaders() override {
-    if (!readOnly()) exec("PRAGMA journal_mode=WAL");
-  }
+  void enableConcurrentReaders() override;
 
   sqlite3* handle() const { return db_; }
   // Throws DatabaseError (DatabaseBusy for SQLITE_BUSY/LOCKED) when `rc` is an error.
@@ -181,6 +181,24 @@ SqliteConnection::SqliteConnection(const std::string& path, const OpenOptions& o
     sqlite3_close(db_);
     db_ = nullptr;
     throw;
+  }
+}
+
+// SQLite answers SQLITE_BUSY at once, without its busy handler, when another
+// connection holds a lock during the switch from a rollback journal to WAL (the
+// switch needs the file alone). Waiting here as the busy handler would keeps the
+// open's promise: locked only after busy_timeout_ms.
+void SqliteConnection::enableConcurrentReaders() {
+  if (readOnly()) return;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(busy_timeout_ms_);
+  for (auto pause = std::chrono::milliseconds(1);; pause = std::min(pause * 2, std::chrono::milliseconds(50))) {
+    try {
+      exec("PRAGMA journal_mode=WAL");
+      return;
+    } catch (const DatabaseBusy&) {
+      if (std::chrono::steady_clock::now() + pause > deadline) throw;
+    }
+    std::this_thread::sleep_for(pause);
   }
 }
 
