@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstring>
 #include <deque>
+#include <regex>
 #include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -452,7 +453,11 @@ ScanBatch ScannerClient::receiveScans(size_t max_scans, double max_seconds) {
 ScanData ScannerClient::nextScan() {
   ScanBatch b = receiveScans(1, params_.scan_timeout_s);
   if (b.scans.empty()) {
-    if (b.connection_lost) throw ScannerError("[ScannerClient::nextScan] " + b.message);
+    // The batch of one counts none; the user wants the scans this connection brought.
+    if (b.connection_lost)
+      throw ScannerError("[ScannerClient::nextScan] " +
+                         std::regex_replace(b.message, std::regex("lost after 0 scans"),
+                                            "lost after " + std::to_string(impl_->stats.scans) + " scans"));
     throw ScannerError("[ScannerClient::nextScan] no scan from " + impl_->where + " within " + seconds(params_.scan_timeout_s));
   }
   return std::move(b.scans.front());

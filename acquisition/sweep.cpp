@@ -170,10 +170,13 @@ struct Streamed {
   // (seconds): a scan that arrives late (a busy network, or a device draining its output) is still placed
   // at its own time.
   double clock_offset_s = std::numeric_limits<double>::infinity();
+  // The turntable stopped answering: β is known up to its last reported angle only.
+  bool table_lost = false;
 };
 
 // Commands the sweep move and keeps every scan until the turntable is idle, judged by each scan's own
-// start; a turntable fault, a scanner error or a move overrunning its time end the sweep as partial.
+// start; a turntable fault or lost link, a scanner error or a move overrunning its time end the sweep as
+// partial.
 // Stops the turntable (partial) and the scanner's stream either way.
 Streamed streamSweep(TurntableClient& table, ScannerClient& scanner, const UnitConfig& unit,
                      const SweepOptions& options, Sweep& sweep, const Progress& progress) {
@@ -192,7 +195,16 @@ Streamed streamSweep(TurntableClient& table, ScannerClient& scanner, const UnitC
   for (;;) {
     const double now = hostTimeSeconds();
     if (now - last_poll > 0.015 || idle_at < 0) {
-      const TurntableStatus st = table.status();
+      TurntableStatus st;
+      try {
+        st = table.status();
+      } catch (const TurntableError& e) {
+        // The turntable's link is gone (a unit losing power): the scans so far are kept.
+        sweep.partial = true;
+        sweep.message = std::string("turntable lost: ") + e.what();
+        out.table_lost = true;
+        break;
+      }
       const double t = hostTimeSeconds();
       table_samples.push_back({0.5 * (now + t), countsToDeg(st.counts)});
       last_poll = t;
@@ -230,7 +242,8 @@ Streamed streamSweep(TurntableClient& table, ScannerClient& scanner, const UnitC
     try {
       table.stop();
     } catch (const TurntableError& e) {
-      sweep.warnings.push_back(std::string("stopping the turntable: ") + e.what());
+      sweep.warnings.push_back(std::string("the turntable may still be turning: stopping it failed: ") + e.what());
+      out.table_lost = true;
     }
   }
   try {
@@ -238,7 +251,14 @@ Streamed streamSweep(TurntableClient& table, ScannerClient& scanner, const UnitC
   } catch (const ScannerError& e) {
     sweep.warnings.push_back(std::string("stop sequence: ") + e.what());
   }
-  table_samples.push_back({hostTimeSeconds(), table.sample().deg()});
+  if (!out.table_lost) {
+    try {
+      table_samples.push_back({hostTimeSeconds(), table.sample().deg()});
+    } catch (const TurntableError& e) {
+      out.table_lost = true;  // the whole unit went down, its scanner first
+      sweep.warnings.push_back(std::string("turntable lost: ") + e.what());
+    }
+  }
   return out;
 }
 
@@ -305,6 +325,9 @@ std::vector<std::pair<uint16_t, double>> assemblePoints(const Streamed& streamed
     const double period_s = s.scan_frequency > 0 ? 100.0 / s.scan_frequency : 1.0 / unit.frequency_hz;
     const double scan_host_start = s.time_since_startup_us * 1e-6 + clock_offset;
     if (scan_host_start < sweep.start_time_s - period_s) continue;
+    // Past the lost turntable's last reported angle, β would be a guess.
+    if (streamed.table_lost && !encoder && scan_host_start + period_s > streamed.table_samples.back().host_time_s)
+      continue;
     EncoderBeta eb;
     if (encoder) {
       if (s.encoders.empty()) {

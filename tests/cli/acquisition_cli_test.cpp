@@ -62,11 +62,14 @@ class EmulatorProcess {
       ::_exit(127);
     }
   }
-  ~EmulatorProcess() {
+  ~EmulatorProcess() { stop(SIGTERM); }
+  // Ends the emulator with `signal` (SIGKILL: a unit losing power, its TCP connection and pty gone at once).
+  void stop(int signal) {
     if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
+      ::kill(pid_, signal);
       int status = 0;
       ::waitpid(pid_, &status, 0);
+      pid_ = -1;
     }
   }
   // The port it printed, or 0 after the timeout.
@@ -179,6 +182,59 @@ TEST(AcquisitionCli, AScannerStillSpinningUpPastTheReadyTimeoutIsOneErrorAndNoSc
   EXPECT_NE(r.err.find("ready_timeout_s must be > 0"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(d / "out2")) << "refused before anything is written";
+}
+
+TEST(AcquisitionCli, AUnitDroppingMidSweepKeepsWhatItSentAndFailsTheCommand) {
+  const ScratchDir d("dropped");
+  writeText(d / "room.json", kRoom);
+  EmulatorProcess emu(d, "--model lms511 --port 0 --scene '" + (d / "room.json").string() + "' --serial-link '" +
+                             (d / "tt").string() + "' --duration 120");
+  const int port = emu.port();
+  ASSERT_GT(port, 0) << readText(d / "emulator.txt");
+  // A slow sweep (200° at 20 °/s: 10 s) so the unit drops while the turntable moves.
+  nlohmann::json unit{{"name", "room-unit"}, {"port", port}, {"serial_device", (d / "tt").string()},
+                      {"model", "lms511"},   {"frequency_hz", 25}, {"resolution_deg", 0.1667},
+                      {"start_angle_deg", -100}, {"sweep_angle_deg", 200}, {"speed_deg_s", 20},
+                      {"acceleration_deg_s2", 200}};
+  writeText(d / "unit.json", unit.dump());
+  sailshape::testing::Outcome r;
+  std::thread scan([&] {
+    r = runSailshape(d, "scan --quiet --unit '" + (d / "unit.json").string() + "' --out '" + (d / "out").string() + "'");
+  });
+  // The capture starts when the scanner streams, before the move to the start angle (under 2 s at the
+  // positioning speed); 6 s later the turntable is 4-6 s into its 10 s sweep. Then pull the plug.
+  const fs::path capture = d / "out" / "room-unit.sscap";
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  auto captured = [&] {
+    std::error_code ec;
+    const auto size = fs::file_size(capture, ec);
+    return ec ? 0 : size;
+  };
+  while (std::chrono::steady_clock::now() < give_up && captured() == 0)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::this_thread::sleep_for(std::chrono::seconds(6));
+  emu.stop(SIGKILL);
+  scan.join();
+  EXPECT_NE(r.exit_code, 0) << "a sweep cut short fails the command";
+  // One error line; the turntable, gone with the unit, may still turn: one warning says so.
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
+  EXPECT_NE(r.err.find("sailshape: error: room-unit: partial sweep"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("warning: room-unit: the turntable may still be turning"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("after 0 scans"), std::string::npos) << r.err;
+  // What arrived before the drop is written, as the help promises.
+  ASSERT_TRUE(fs::exists(d / "out" / "room-unit.ply")) << r.err;
+  ASSERT_TRUE(fs::exists(d / "out" / "scan.json"));
+  const auto doc = nlohmann::json::parse(readText(d / "out" / "scan.json"));
+  EXPECT_TRUE(doc["units"][0]["partial"].get<bool>());
+  const int points = doc["units"][0]["points"].get<int>();
+  EXPECT_GT(points, 1000) << "the scans received before the drop";
+  // The sweep stopped short of its end angle (start -100 + 200).
+  EXPECT_LT(doc["units"][0]["beta_end_deg"].get<double>(), 95.0);
+  // The cloud file holds exactly the kept points.
+  const std::string ply = readText(d / "out" / "room-unit.ply");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(ply, m, std::regex("element vertex ([0-9]+)")));
+  EXPECT_EQ(std::stoi(m[1]), points);
 }
 
 TEST(AcquisitionCli, ErrorsAreOneLine) {
