@@ -47,7 +47,7 @@ struct MissingSection {
 };
 
 void printTable(const CompareOptions& o, const DesignImport& design, const DesignComparison& c, const std::string& what,
-                const std::vector<MissingSection>& missing) {
+                const std::vector<MissingSection>& missing, const std::string& outline_refused) {
   std::printf("Design %s (%s, %s, %s axes)\nFlying %s\n", o.design.c_str(), design.format.c_str(), design.unit.c_str(),
               design.axes.c_str(), o.flying.c_str());
   const DistanceStats& s = c.stats;
@@ -55,6 +55,8 @@ void printTable(const CompareOptions& o, const DesignImport& design, const Desig
               s.count, what.c_str(), c.leeward.x(), c.leeward.y(), c.leeward.z());
   std::printf("  mean %+.1f  rms %.1f  max |d| %.1f  p5 %+.1f  p50 %+.1f  p95 %+.1f\n", 1000 * s.mean_m, 1000 * s.rms_m,
               1000 * s.max_abs_m, 1000 * s.p5_m, 1000 * s.p50_m, 1000 * s.p95_m);
+  if (!outline_refused.empty())
+    std::printf("\nOutline and sections not measured on the flying shape: %s\n", outline_refused.c_str());
   std::printf("\nSections: design / flying (flying - design)\n");
   std::printf("%6s %22s %22s %22s %22s %22s %22s\n", "height", "chord m", "camber %", "draft %", "twist deg",
               "entry deg", "exit deg");
@@ -94,6 +96,9 @@ void run(const CompareOptions& o) {
   SectionAnalysis flying_sections;
   std::vector<std::string> warnings;
   std::string what;
+  // Why the flying shape has no outline (a patch of a sail, a scan short of a corner): its
+  // distances to the design still stand, its sections are not measured.
+  std::string outline_refused;
   std::string ext = std::filesystem::path(o.flying).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
   const bool is_mesh = ext == ".obj" || ext == ".stl" || (ext == ".ply" && plyHasFaces(o.flying));
@@ -103,9 +108,13 @@ void run(const CompareOptions& o) {
     OutlineParams op;
     op.design_lengths_m = {design_sections.outline.luff_length_m, design_sections.outline.leech_length_m,
                            design_sections.outline.foot_length_m};
-    const MeshSections fs = analyzeMeshSections(flying, op, sp);
-    flying_sections = fs.sections;
-    warnings = fs.outline.warnings;
+    try {
+      const MeshSections fs = analyzeMeshSections(flying, op, sp);
+      flying_sections = fs.sections;
+      warnings = fs.outline.warnings;
+    } catch (const AnalysisError& e) {
+      outline_refused = userMessage(e.what());
+    }
     points = flying.vertices;
     what = "flying mesh vertices";
   } else {
@@ -117,7 +126,15 @@ void run(const CompareOptions& o) {
                                        design_sections.outline.foot_length_m};
     CloudReadResult read = readCloud(o.flying);
     for (const auto& w : read.warnings) std::fprintf(stderr, "warning: %s: %s\n", o.flying.c_str(), w.c_str());
-    SailAnalysis a = analyzeSail(read.cloud, params, bar.progress());
+    SailAnalysis a;
+    SailAnalysis surface_only;
+    try {
+      a = analyzeSail(read.cloud, params, bar.progress(), &surface_only);
+    } catch (const AnalysisError& e) {
+      if (surface_only.sail_cloud.empty()) throw;  // no sail surface: nothing to compare
+      a = std::move(surface_only);
+      outline_refused = userMessage(e.what());
+    }
     flying_sections = a.sections;
     warnings = a.warnings;
     if (o.raw_distances) {
@@ -128,6 +145,8 @@ void run(const CompareOptions& o) {
       what = "sail points (segmented, cleaned, smoothed)";
     }
   }
+  if (!outline_refused.empty())
+    for (double fraction : sectionFractions(sp)) flying_sections.unmeasured.push_back({fraction, "no outline on the flying shape"});
   DesignComparison c = compareWithDesign(design.mesh, design_sections.sections, points, flying_sections, bar.progress());
   bar.finish();
   c.warnings.insert(c.warnings.begin(), warnings.begin(), warnings.end());
@@ -146,7 +165,7 @@ void run(const CompareOptions& o) {
     if (!o.quiet) std::fprintf(stderr, "wrote %s (intensity = signed distance, mm)\n", o.distances_out.c_str());
   }
   if (o.json_out.empty()) {
-    printTable(o, design, c, what, missing);
+    printTable(o, design, c, what, missing, outline_refused);
     return;
   }
   nlohmann::json doc;
@@ -154,6 +173,8 @@ void run(const CompareOptions& o) {
                    {"notes", design.notes}};
   doc["flying"] = {{"file", o.flying}, {"kind", is_mesh ? "mesh" : "cloud"}, {"points", points.size()},
                    {"distances_of", what}};
+  doc["flying"]["outline"] = outline_refused.empty() ? nlohmann::json("measured")
+                                                     : nlohmann::json("not measured: " + outline_refused);
   const DistanceStats& s = c.stats;
   doc["distance"] = {{"count", s.count},       {"mean_m", s.mean_m}, {"rms_m", s.rms_m}, {"max_abs_m", s.max_abs_m},
                      {"p5_m", s.p5_m},         {"p50_m", s.p50_m},   {"p95_m", s.p95_m},

@@ -469,7 +469,8 @@ void refuseImplausibleResults(const SailAnalysis& a) {
 
 }  // namespace
 
-SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
+SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress,
+                         SailAnalysis* surface_only) {
   checkAnalysisParams(input, p);
   SailAnalysis a;
   a.points_in = input.size();
@@ -505,9 +506,20 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), s.warnings);
   }
   meshSurface(cloud, p, progress, a, loose);
-  outlineSail(input, sail_scan, working.scan_points, scene, p, a, loose);
-  measureSections(p, a);
-  refuseImplausibleResults(a);
+  try {
+    outlineSail(input, sail_scan, working.scan_points, scene, p, a, loose);
+    measureSections(p, a);
+    refuseImplausibleResults(a);
+  } catch (const AnalysisError&) {
+    if (surface_only) {
+      a.outline = SailOutline{};
+      a.sections = SectionAnalysis{};
+      a.luff = LuffCurve{};
+      a.sail_cloud = std::move(cloud);
+      *surface_only = std::move(a);
+    }
+    throw;
+  }
   progress("done", 1.0);
   a.sail_cloud = std::move(cloud);
   return a;

@@ -109,7 +109,12 @@ Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p);
 std::vector<std::string> widenCornersBesideLostLines(SailOutline& outline, const Cloud& scan);
 
 // Throws InvalidInput for an empty cloud or bad parameters, AnalysisError when
-// a stage cannot produce its result (no sail found, no boundary, ...).
-SailAnalysis analyzeSail(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {});
+// a stage cannot produce its result (no sail found, no boundary, ...). When the
+// outline or the sections refuse (a patch of a sail, a scan that never reached a
+// corner) and `surface_only` is given, it receives what was measured before the
+// refusal, the sail's points and surface (outline and sections empty), and the
+// AnalysisError is thrown on: distances to a design need no outline.
+SailAnalysis analyzeSail(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {},
+                         SailAnalysis* surface_only = nullptr);
 
 }  // namespace sailshape

@@ -571,6 +571,48 @@ TEST_F(Cli, CompareNamesASectionTheFlyingScanCouldNotMeasure) {
       << r.out;
 }
 
+TEST_F(Cli, CompareGivesTheDistancesOfAPatchAndListsWhatItCouldNotMeasure) {
+  ASSERT_EQ(sailshape("design new --type main --out " + path("design.ply")).exit_code, 0);
+  ASSERT_EQ(sailshape("simulate --type main --points 40000 --out " + path("scan.xyz") + " --truth " + path("t.json")).exit_code, 0);
+  // A patch of the mid-leech, 3 m high and about 1.7 m wide, moved 30 mm to port (the sail's leeward side):
+  // no corner, no whole section in it.
+  constexpr double kShiftM = 0.030;
+  {
+    std::ifstream in(path("scan.xyz"));
+    std::ofstream out(path("patch.xyz"));
+    for (std::string line; std::getline(in, line);) {
+      Eigen::Vector3d p;
+      if (line.empty() || line[0] == '#' || !(std::istringstream(line) >> p.x() >> p.y() >> p.z())) continue;
+      if (p.z() > 4 && p.z() < 7 && p.x() > -2.5 && p.x() < -0.8)
+        out << p.x() << " " << p.y() + kShiftM << " " << p.z() << "\n";
+    }
+  }
+  Outcome r = sailshape("compare --design " + path("design.ply") + " --flying " + path("patch.xyz") + " -q --json " +
+                        path("cmp.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json doc = json::parse(readText(path("cmp.json")));
+  EXPECT_GT(doc["distance"]["count"].get<int>(), 5000);
+  // Moved by s along +Y, a point lies s·n_y from the surface, n the design's normal there; over this patch
+  // the main's normal is within 25° of +Y (n_y 0.9 to 1). The smoothed scan sits on the design within a mm.
+  const double mean = doc["distance"]["mean_m"].get<double>();
+  EXPECT_GT(mean, 0.9 * kShiftM - 0.001);
+  EXPECT_LT(mean, kShiftM + 0.001);
+  EXPECT_LT(doc["distance"]["p95_m"].get<double>() - doc["distance"]["p5_m"].get<double>(), 0.1 * kShiftM + 0.004);
+  // The outline and every section are named as not measured on the flying side, and why.
+  EXPECT_NE(doc["flying"]["outline"].get<std::string>().find("not measured: "), std::string::npos);
+  EXPECT_EQ(doc["flying"]["outline"].get<std::string>().find("[extract"), std::string::npos) << "no internal names";
+  EXPECT_EQ(doc["sections"].size(), 0u);
+  ASSERT_EQ(doc["unmeasured_sections"].size(), 3u);
+  for (const auto& u : doc["unmeasured_sections"]) {
+    EXPECT_EQ(u["side"], "flying");
+    EXPECT_EQ(u["reason"], "no outline on the flying shape");
+  }
+  r = sailshape("compare --design " + path("design.ply") + " --flying " + path("patch.xyz") + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("Outline and sections not measured on the flying shape: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("50% not measured on the flying: no outline on the flying shape"), std::string::npos) << r.out;
+}
+
 // The tree as the README draws it: every analysis sub-library is a folder with a
 // README and a CMake target, named in the README's layout table, and no source file
 // in analysis/ is longer than a reader can hold (about 900 lines).
