@@ -233,6 +233,22 @@ TEST_F(Cli, AMissingInputIsOneLineNamingTheFile) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+TEST_F(Cli, ACloudTooSmallToBeASailIsOneLineSayingHowManyItNeeds) {
+  {
+    std::ofstream out(path("three.xyz"));
+    out << "0 0 0\n1 0 0\n0 1 0\n";
+  }
+  const Outcome r = sailshape("analyze " + path("three.xyz") + " -q");
+  EXPECT_EQ(r.exit_code, 1);
+  const auto err = lines(r.err);
+  ASSERT_EQ(err.size(), 1u) << r.err;
+  // The smoothing's neighbourhood (200 by default) is the largest any stage needs.
+  EXPECT_NE(err[0].find("the cloud has 3 points: too few to be a sail's scan (the analysis needs at least 200"),
+            std::string::npos)
+      << err[0];
+  EXPECT_EQ(err[0].find("["), std::string::npos) << "no internal function names: " << err[0];
+}
+
 TEST_F(Cli, AGarbagePlyIsOneClearLine) {
   // Not a PLY at all.
   const std::string junk = path("junk.ply");
