@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     min_w = max_w = g_widths.front();
     for (uint32_t w : g_widths) min_w = std::min(min_w, w), max_w = std::max(max_w, w);
   }
-  std::printf("init %s, clouds %zu, first after %.2f s, rate %.2f Hz, points per cloud %u..%u\n",
+  std::printf("\nsummary: init %s, clouds %zu, first after %.2f s, rate %.2f Hz, points per cloud %u..%u\n",
               init == SICK_SCAN_API_SUCCESS ? "ok" : "FAILED", g_arrivals_s.size(),
               g_arrivals_s.empty() ? 0.0 : g_arrivals_s.front(), rate_hz, min_w, max_w);
   std::fflush(stdout);

@@ -19,7 +19,7 @@ sailshape="$root/build/cli/sailshape"
 [ -f "$bld/libsick_scan_xd_shared_lib.so" ] || { echo "run.sh: $bld/libsick_scan_xd_shared_lib.so is missing" >&2; exit 1; }
 
 work="$(mktemp -d /tmp/sick-scan-xd-bench.XXXXXX)"
-trap 'pkill -P $$ 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'pkill -P $$ 2>/dev/null || true; [ -n "${KEEP:-}" ] || rm -rf "$work"' EXIT
 g++ -O2 -std=c++17 -I"$src/include" "$here/client.cpp" -L"$bld" -lsick_scan_xd_shared_lib \
     -Wl,-rpath,"$bld" -lpthread -o "$work/client"
 
@@ -44,8 +44,9 @@ for model in lms111 lms511; do
     [ -n "$port" ] || { echo "run.sh: the emulator did not start: $(cat "$work/emulator.txt")" >&2; exit 1; }
     log="$work/$model-$dialect.log"
     # The driver does not always end its threads; the client prints its counts and exits hard.
-    summary="$(cd "$src" && timeout -s KILL $((seconds + 30)) "$work/client" \
-      "$launch hostname:=127.0.0.1 port:=$port use_binary_protocol:=$binary" "$seconds" 2>"$log" | tail -1 || true)"
+    (cd "$src" && timeout -s KILL $((seconds + 30)) "$work/client" \
+      "$launch hostname:=127.0.0.1 port:=$port use_binary_protocol:=$binary" "$seconds" >"$log" 2>&1 || true)
+    summary="$(grep -a -o 'summary: .*' "$log" | cut -c10- || true)"
     kill "$emu" 2>/dev/null || true
     wait "$emu" 2>/dev/null || true
     errors="$(grep -a -c '\[Error\]' "$log" || true)"
