@@ -1,4 +1,5 @@
 // `sailshape analyze`: the analysis pipeline on one cloud.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -76,9 +77,19 @@ void printTable(const SailAnalysis& a) {
     }
     const Section& s = measured[i++];
     const SectionParameters &v = s.value, &u = s.uncertainty;
-    std::printf("%7.0f%% %9.3f %6.2f ±%5.2f %6.1f ±%5.1f %6.2f ±%5.2f %6.2f ±%5.2f %5.1f ±%5.1f %5.1f ±%5.1f\n",
-                100 * s.fraction, v.chord_m, v.camber_pct, u.camber_pct, v.draft_pct, u.draft_pct, v.twist_deg,
-                u.twist_deg, v.twist_rel_deg, u.twist_rel_deg, v.entry_deg, u.entry_deg, v.exit_deg, u.exit_deg);
+    // "value ± σ" in `width` characters; a value the section could not measure is a dash (the warnings say why).
+    auto cell = [](double value, double sd, int width, int digits) {
+      char buf[64];
+      if (std::isfinite(value))
+        std::snprintf(buf, sizeof(buf), "%*.*f ±%*.*f", width - 8, digits, value, 5, digits, sd);
+      else
+        return std::string(width - 9, ' ') + "—" + std::string(8, ' ');  // "—" is one column, three bytes
+      return std::string(buf);
+    };
+    std::printf("%7.0f%% %9.3f %s %s %s %s %s %s\n", 100 * s.fraction, v.chord_m,
+                cell(v.camber_pct, u.camber_pct, 14, 2).c_str(), cell(v.draft_pct, u.draft_pct, 14, 1).c_str(),
+                cell(v.twist_deg, u.twist_deg, 14, 2).c_str(), cell(v.twist_rel_deg, u.twist_rel_deg, 14, 2).c_str(),
+                cell(v.entry_deg, u.entry_deg, 13, 1).c_str(), cell(v.exit_deg, u.exit_deg, 13, 1).c_str());
   }
   if (!a.warnings.empty()) {
     std::printf("\nWarnings:\n");

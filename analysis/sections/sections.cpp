@@ -671,7 +671,8 @@ Crest measureCrest(double t, const std::vector<Eigen::Vector2d>& xy, const Frame
 // flat facets, whose slopes step by about a degree from facet to facet on a curved
 // section 4 cm apart: ten points average those steps to a quarter of a degree.
 double endAngle(bool at_luff, double t, const std::vector<Eigen::Vector2d>& xy, const Frame& f, double side,
-                const Cut& cut, const SectionParams& p, std::vector<std::string>& warnings, double& sd_deg) {
+                const Cut& cut, const SectionParams& p, std::vector<std::string>& warnings, double& sd_deg,
+                std::map<std::string, std::string>& not_measured) {
   constexpr size_t kMinEndPoints = 6, kWantedEndPoints = 10;
   const char* const which = at_luff ? "entry" : "exit";
   std::vector<Eigen::Vector2d> win;
@@ -691,9 +692,10 @@ double endAngle(bool at_luff, double t, const std::vector<Eigen::Vector2d>& xy, 
   const QuadFit q = win.size() >= kMinEndPoints ? fitQuadratic(win, x_end, p.surface_sigma_m) : QuadFit{};
   if (!q.ok) {
     sd_deg = std::numeric_limits<double>::quiet_NaN();
-    warnings.push_back("section " + formatFixed(t, 3) + ": too few points for the " + which + " angle (" +
-                       std::to_string(win.size()) + " within " + formatFixed(100 * window, 0) +
-                       " % of the chord)");
+    const std::string why = "too few points for the " + std::string(which) + " angle (" + std::to_string(win.size()) +
+                            " within " + formatFixed(100 * window, 0) + " % of the chord)";
+    warnings.push_back("section " + formatFixed(t, 3) + ": " + why);
+    not_measured[std::string(which) + "_deg"] = why;
     return std::numeric_limits<double>::quiet_NaN();
   }
   if (window > p.end_window)
@@ -782,8 +784,8 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
   v.camber_pct = 100.0 * crest.depth / f.chord;
   v.draft_pct = 100.0 * crest.depth_x / f.chord;
   v.twist_deg = twistDeg(f.L, f.R);
-  v.entry_deg = endAngle(true, t, xy, f, crest.side, cut, p, warnings, u.entry_deg);
-  v.exit_deg = endAngle(false, t, xy, f, crest.side, cut, p, warnings, u.exit_deg);
+  v.entry_deg = endAngle(true, t, xy, f, crest.side, cut, p, warnings, u.entry_deg, s.not_measured);
+  v.exit_deg = endAngle(false, t, xy, f, crest.side, cut, p, warnings, u.exit_deg, s.not_measured);
   const double chord_dir_sd = sigma_ends / f.chord;  // rad
   const double chord_xy = std::hypot(f.R.x() - f.L.x(), f.R.y() - f.L.y());
   // The corners' places move the chord's ends along the edges (CornerSpread);

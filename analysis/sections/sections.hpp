@@ -1,5 +1,6 @@
 #pragma once
 // Sections and their shape parameters: the contract of SPEC §5.
+#include <map>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,9 @@ struct Section {
   std::vector<Vec3> curve;            // boat frame, luff to leech
   size_t curve_samples = 0;           // cut points the parameters were computed from
   double bridged_pct = 0;             // % of the chord bridged across holes (see max_bridged_gap)
+  // Values this section could not measure, by name ("entry_deg"), with why; each is NaN in
+  // `value` and `uncertainty`, and is no result.
+  std::map<std::string, std::string> not_measured;
 };
 
 // A section asked for that could not be measured, and why: its plane found no

@@ -448,6 +448,8 @@ TEST_F(Cli, SimulatedMainIsMeasuredWithinHalfAPercentOfCamber) {
         warned = warned || w.get<std::string>().find("section " + fixed3(fractions[k]) + ": too few points for the " +
                                                      angle) != std::string::npos;
       EXPECT_TRUE(warned) << key << " is null without a warning";
+      ASSERT_TRUE(s.contains("not_measured")) << "a null value is named as not measured";
+      EXPECT_NE(s["not_measured"][key].get<std::string>().find("too few points for the " + angle), std::string::npos);
     }
     ASSERT_TRUE(s["curve"].is_array());
     EXPECT_GE(s["curve"].size(), 2u);

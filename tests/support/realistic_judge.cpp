@@ -94,7 +94,14 @@ void judgeAnalysis(const SailAnalysis* a, const std::string& refusal, const Trut
     const double sigma[] = {s.uncertainty.camber_pct, s.uncertainty.draft_pct, s.uncertainty.twist_deg,
                             s.uncertainty.entry_deg, s.uncertainty.exit_deg};
     const double known[] = {k.camber_pct, k.draft_pct, k.twist_deg, k.entry_deg, k.exit_deg};
-    for (int i = 0; i < 5; ++i) out.values.push_back(scalar(at(names[i], s.fraction), measured[i], sigma[i], known[i], targets[i]));
+    for (int i = 0; i < 5; ++i) {
+      // A value the section names as not measured is no result; any other NaN is judged (wrong).
+      const auto why = s.not_measured.find(names[i]);
+      if (why != s.not_measured.end())
+        out.values.push_back(refused(at(names[i], s.fraction), known[i], targets[i], why->second));
+      else
+        out.values.push_back(scalar(at(names[i], s.fraction), measured[i], sigma[i], known[i], targets[i]));
+    }
   }
   for (const UnmeasuredSection& u : a->sections.unmeasured)
     for (int i = 0; i < 5; ++i) out.values.push_back(refused(at(names[i], u.fraction), 0, targets[i], u.reason));

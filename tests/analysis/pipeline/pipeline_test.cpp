@@ -1130,6 +1130,30 @@ TEST(Pipeline, ASparseSectionReadsItsEndAnglesOverAWiderWindow) {
   }
 }
 
+TEST(Pipeline, AnEndAngleWithTooFewPointsIsNamedAsNotMeasuredNotReportedAsNaN) {
+  // 2,500 samples over the 20 m² example main (about 9 cm apart): the upper section's 0.9 m chord
+  // holds fewer than six cut points within 20 % of an end.
+  const SailDesign design = exampleDesign(SailType::Main);
+  const SailAnalysis a = analyzeSail(sampleSail(design, scan(2500, 1)));
+  size_t named = 0;
+  for (const Section& s : a.sections.sections) {
+    SCOPED_TRACE("section at " + std::to_string(s.fraction));
+    const std::pair<const char*, double> values[] = {
+        {"chord_m", s.value.chord_m},     {"camber_pct", s.value.camber_pct}, {"draft_pct", s.value.draft_pct},
+        {"twist_deg", s.value.twist_deg}, {"entry_deg", s.value.entry_deg},   {"exit_deg", s.value.exit_deg}};
+    // A value is NaN exactly when the section names it as not measured, with why.
+    for (const auto& [name, value] : values) {
+      const auto why = s.not_measured.find(name);
+      EXPECT_EQ(std::isnan(value), why != s.not_measured.end()) << name;
+      if (why != s.not_measured.end()) {
+        EXPECT_NE(why->second.find("too few points for the"), std::string::npos) << why->second;
+        ++named;
+      }
+    }
+  }
+  EXPECT_GE(named, 1u) << "this sparse a scan leaves an upper end angle unmeasured";
+}
+
 // The cut points lie on the mesh's flat facets, whose slopes step from one to the
 // next on a curved section. Read from six points, the upper section's end angles
 // of 12,000-point mains spread by 0.5°: 12 of 100 seeds had one over the clean 1°
