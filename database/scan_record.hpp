@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/core/cloud.hpp"
+#include "analysis/core/mesh.hpp"
 #include "analysis/sections/sections.hpp"
 #include "database/sqlite.hpp"
 
@@ -57,6 +58,11 @@ std::vector<Section> analysisSections(Database& db, int64_t analysis_id);
 // The outline analysis `analysis_id` stored (analyses.sail: the `sail` object of
 // `sailshape analyze --json`, its luff curve inside) as JSON text; empty when none.
 std::string analysisOutlineJson(Database& db, int64_t analysis_id);
+
+// The surface analysis `analysis_id` reconstructed (analyses.surface_mesh: metres,
+// boat frame); none for an analysis stored without it (imported from its JSON
+// alone, or before schema version 4). Throws DatabaseError for a damaged blob.
+std::optional<Mesh> analysisSurface(Database& db, int64_t analysis_id);
 
 // The sections analysis `analysis_id` was asked for but could not measure, with
 // why (stored in its diagnostics by importScan); empty when there were none.
