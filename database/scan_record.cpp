@@ -61,6 +61,7 @@ ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
 
   r.sections.sections = analysisSections(db, r.analysis_id);
   r.sections.unmeasured = unmeasuredSections(db, r.analysis_id);
+  r.surface = analysisSurface(db, r.analysis_id);
   return r;
 }
 

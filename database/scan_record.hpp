@@ -29,6 +29,7 @@ struct ScanRecord {
   // points are the curve's ends and max_camber_point is not stored (left zero); a
   // parameter stored as NULL (not measurable) is NaN.
   SectionAnalysis sections;
+  std::optional<Mesh> surface;     // the surface that analysis reconstructed, when stored with it (schema 4)
   nlohmann::json analysis_params;  // the pipeline parameters it ran with (null when unknown)
   nlohmann::json settings;         // the acquisition settings stored with the scan (null when none)
   std::optional<Eigen::Matrix4d> registration;  // the latest scanner-to-boat transform, when registered
