@@ -125,6 +125,20 @@ size_t curvePixels(const Raster& r, int dpi, double x0, double y0, double x1, do
   return n;
 }
 
+// The designer report of `t` written as `name`, and its page titled `title` rasterised at `dpi`.
+struct ShownPage {
+  std::string pdf;
+  int page = 0;
+  Raster raster;
+};
+ShownPage reportPage(const SmallTest& t, const std::string& name, const std::string& title, int dpi) {
+  const TrimReportParams p = t.params(name);
+  writeTrimReport(p);
+  ShownPage shown{p.out_path, pageWith(p.out_path, title), {}};
+  if (shown.page > 0) shown.raster = pageRaster(p.out_path, shown.page, dpi);
+  return shown;
+}
+
 TEST(ReportPictures, PopplerReadsTheFontsWithoutAWarning) {
   const TrimReportParams p = fixture().params("fonts.pdf");
   writeTrimReport(p);
@@ -254,17 +268,15 @@ TEST(ReportPictures, OneDeviationScaleForTheWholeReport) {
 // through the legend and the page's title band.
 TEST(ReportPictures, SectionShapesStayInsideTheirPanels) {
   const SmallTest t(SailType::Gennaker, 2, true, 4.0);
-  const TrimReportParams p = t.params("curves.pdf");
-  writeTrimReport(p);
-  const int page = pageWith(p.out_path, "Section shapes, flying over design");
-  ASSERT_GT(page, 0);
   const int dpi = 100;
-  const Raster r = pageRaster(p.out_path, page, dpi);
+  const ShownPage shown = reportPage(t, "curves.pdf", "Section shapes, flying over design", dpi);
+  ASSERT_GT(shown.page, 0);
+  const Raster& r = shown.raster;
   ASSERT_GT(r.width, 0);
   EXPECT_EQ(curvePixels(r, dpi, 0, 0, 595, 34), 0u) << "curves in the title band";
   size_t curves = curvePixels(r, dpi, 0, 34, 595, 800);
   EXPECT_GT(curves, 2000u) << "the curves are drawn";
-  for (const Word& w : pageWords(p.out_path, page)) {
+  for (const Word& w : pageWords(shown.pdf, shown.page)) {
     if (w.y0 > 800) continue;  // the footer
     EXPECT_LT(curvePixels(r, dpi, w.x0 + 1, w.y0 + 1, w.x1 - 1, w.y1 - 1), 4u) << "a curve runs through \"" << w.text << "\"";
   }
@@ -273,12 +285,10 @@ TEST(ReportPictures, SectionShapesStayInsideTheirPanels) {
 // Sections at 25, 50 and 75 %: the height axis spans them, not 0–100 %.
 TEST(ReportPictures, PlotsSpanTheMeasuredHeights) {
   const SmallTest t(SailType::Main, 1, true);
-  const TrimReportParams p = t.params("plots.pdf");
-  writeTrimReport(p);
-  const int page = pageWith(p.out_path, "Camber, draft and twist up the sail");
-  ASSERT_GT(page, 0);
   const int dpi = 100;
-  const Raster r = pageRaster(p.out_path, page, dpi);
+  const ShownPage shown = reportPage(t, "plots.pdf", "Camber, draft and twist up the sail", dpi);
+  ASSERT_GT(shown.page, 0);
+  const Raster& r = shown.raster;
   ASSERT_GT(r.width, 0);
   // The camber plot's frame: from trim_report's layout (x 72–205 pt, y 98–478 pt); the red
   // flying line joins its three points.
@@ -293,7 +303,7 @@ TEST(ReportPictures, PlotsSpanTheMeasuredHeights) {
   EXPECT_GT((hi - lo) / (380 * s), 0.75) << "the data span " << (hi - lo) / s << " pt of the 380 pt plot";
   // Its height labels are the sections' heights.
   std::set<std::string> labels;
-  for (const Word& w : pageWords(p.out_path, page))
+  for (const Word& w : pageWords(shown.pdf, shown.page))
     if (w.x1 < 72 && w.y0 > 90 && w.y1 < 490) labels.insert(w.text);
   EXPECT_EQ(labels, (std::set<std::string>{"25", "50", "75"}));
 }
