@@ -139,6 +139,19 @@ ShownPage reportPage(const SmallTest& t, const std::string& name, const std::str
   return shown;
 }
 
+// Pairs of words on page `page` whose boxes overlap (by more than half a point), as "a / b".
+std::vector<std::string> overprintedWords(const std::string& pdf, int page) {
+  std::vector<std::string> out;
+  const std::vector<Word> words = pageWords(pdf, page);
+  for (size_t i = 0; i < words.size(); ++i)
+    for (size_t j = i + 1; j < words.size(); ++j) {
+      const Word &a = words[i], &b = words[j];
+      if (a.x0 < b.x1 - 0.5 && b.x0 < a.x1 - 0.5 && a.y0 < b.y1 - 0.5 && b.y0 < a.y1 - 0.5)
+        out.push_back("page " + std::to_string(page) + ": \"" + a.text + "\" overprints \"" + b.text + "\"");
+    }
+  return out;
+}
+
 TEST(ReportPictures, PopplerReadsTheFontsWithoutAWarning) {
   const TrimReportParams p = fixture().params("fonts.pdf");
   writeTrimReport(p);
@@ -321,13 +334,29 @@ TEST(ReportPictures, StepTableHeadingsDoNotOverprintAndControlsReadInWords) {
     EXPECT_NE(text.find("gennaker tack ease 0 → 0.02 m"), std::string::npos);
     const int page = pageWith(p.out_path, "Trim steps: what changed");
     ASSERT_GT(page, 0);
-    const std::vector<Word> words = pageWords(p.out_path, page);
-    for (size_t i = 0; i < words.size(); ++i)
-      for (size_t j = i + 1; j < words.size(); ++j) {
-        const Word &a = words[i], &b = words[j];
-        EXPECT_FALSE(a.x0 < b.x1 - 0.5 && b.x0 < a.x1 - 0.5 && a.y0 < b.y1 - 0.5 && b.y0 < a.y1 - 0.5)
-            << "\"" << a.text << "\" overprints \"" << b.text << "\"";
-      }
+    const std::vector<std::string> clashes = overprintedWords(p.out_path, page);
+    EXPECT_TRUE(clashes.empty()) << clashes.front();
+  }
+}
+
+// Nothing on any page of either audience's report, for a main of eight sections and a
+// gennaker of three, is printed over anything else.
+TEST(ReportPictures, NoWordOverprintsAnotherOnAnyPage) {
+  const SmallTest gennaker(SailType::Gennaker, 3, true, 4.0);
+  std::vector<TrimReportParams> reports = {fixture().params("all-designer.pdf"), gennaker.params("g-designer.pdf"),
+                                           gennaker.params("g-crew.pdf", "crew")};
+  TrimReportParams crew = fixture().params("all-crew.pdf");
+  crew.audience = "crew";
+  reports.push_back(crew);
+  for (const TrimReportParams& p : reports) {
+    SCOPED_TRACE(p.out_path);
+    const TrimReport written = writeTrimReport(p);
+    for (int page = 1; page <= written.pages; ++page) {
+      const std::vector<std::string> clashes = overprintedWords(p.out_path, page);
+      EXPECT_TRUE(clashes.empty()) << clashes.size() << " clashes, first " << clashes.front();
+      for (const Word& w : pageWords(p.out_path, page))
+        EXPECT_TRUE(w.x0 >= 0 && w.x1 <= 595.3 && w.y0 >= 0 && w.y1 <= 841.9) << "off the page: " << w.text;
+    }
   }
 }
 
