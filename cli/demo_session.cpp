@@ -551,7 +551,8 @@ void storeStep(DemoRun& run, Database& db, int step, const std::string& tag, con
                            {"start_spread_ms", us.row.start_spread_ms}};
     m.raw_capture = capturePath(run.capture_dir, step, u);
     const json doc = us.analysis ? analysisToJson(*us.analysis) : json();
-    const ImportResult r = importScan(db, m, us.analysis ? &doc : nullptr, &us.boat_cloud);
+    const ImportResult r =
+        importScan(db, m, us.analysis ? &doc : nullptr, &us.boat_cloud, {}, us.analysis ? &us.analysis->mesh : nullptr);
     addRegistration(db, r.scan_id, us.used.matrix(), us.registration.fitness_rms_m, us.registration.fitness_rms_m);
     us.row.scan_id = r.scan_id;
     run.result.scans.push_back(us.row);

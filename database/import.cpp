@@ -5,6 +5,7 @@
 
 #include "analysis/core/errors.hpp"
 #include "analysis/core/plausible.hpp"
+#include "database/catalog.hpp"
 #include "database/cloud_blob.hpp"
 
 namespace sailshape {
@@ -61,10 +62,12 @@ void refuseImplausibleSail(const nlohmann::json& sail, const char* function) {
 
 // Writes the analysis row and its sections; the caller holds the transaction.
 int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, const std::string& software_version,
-                      const char* function, size_t* sections_written, const ImportHook& hook) {
+                      const std::vector<uint8_t>* surface_blob, const char* function, size_t* sections_written,
+                      const ImportHook& hook) {
   Statement a = db.prepare(
-      "INSERT INTO analyses(scan_id, software_version, params, sail, diagnostics) VALUES (?, ?, ?, ?, ?)");
+      "INSERT INTO analyses(scan_id, software_version, params, sail, diagnostics, surface_mesh) VALUES (?, ?, ?, ?, ?, ?)");
   a.bind(1, scan_id).bind(2, software_version);
+  if (surface_blob) a.bindBlob(6, *surface_blob); else a.bindNull(6);
   auto json_or_null = [&](int index, const char* key) {
     if (doc.contains(key)) a.bind(index, doc[key].dump()); else a.bindNull(index);
   };
@@ -142,7 +145,8 @@ int64_t writeAnalysis(Database& db, int64_t scan_id, const nlohmann::json& doc, 
 
 // Every row of one import; the caller holds the transaction.
 void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
-                 const std::vector<uint8_t>* cloud_blob, const ImportHook& hook, ImportResult& result) {
+                 const std::vector<uint8_t>* cloud_blob, const std::vector<uint8_t>* surface_blob,
+                 const ImportHook& hook, ImportResult& result) {
   Statement c = db.prepare("SELECT id FROM campaigns WHERE name = ?");
   c.bind(1, meta.campaign);
   int64_t campaign_id;
@@ -238,7 +242,8 @@ void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json*
 
   if (analysis) {
     result.analysis_id =
-        writeAnalysis(db, result.scan_id, *analysis, meta.software_version, "importScan", &result.sections, hook);
+        writeAnalysis(db, result.scan_id, *analysis, meta.software_version, surface_blob, "importScan",
+                      &result.sections, hook);
     if (hook) hook("sections");
   }
 }
@@ -246,6 +251,12 @@ void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json*
 
 bool hasSectionsArray(const nlohmann::json& doc) {
   return doc.is_object() && doc.contains("sections") && doc["sections"].is_array();
+}
+
+// The analysis's surface as stored; none for a missing or empty mesh.
+std::optional<std::vector<uint8_t>> surfaceBlob(const Mesh* surface) {
+  if (!surface || surface->empty()) return std::nullopt;
+  return packMesh(*surface);
 }
 
 }  // namespace
@@ -266,7 +277,7 @@ std::vector<Vec3> unpackCurve(const std::vector<uint8_t>& blob) {
 
 
 ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis, const Cloud* cloud,
-                        const ImportHook& hook) {
+                        const ImportHook& hook, const Mesh* surface) {
   if (meta.campaign.empty()) throw InvalidInput("[importScan] campaign name must not be empty");
   if (meta.sail.empty()) throw InvalidInput("[importScan] sail name must not be empty");
   if (meta.campaign_kind != "full_scale" && meta.campaign_kind != "wind_tunnel")
@@ -290,27 +301,32 @@ ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann
   // write lock (SQLite) or a retry (PostgreSQL) need not wait for it again.
   const std::optional<std::vector<uint8_t>> cloud_blob =
       cloud ? std::optional<std::vector<uint8_t>>(compressCloud(*cloud)) : std::nullopt;
+  const std::optional<std::vector<uint8_t>> surface_blob = analysis ? surfaceBlob(surface) : std::nullopt;
   ImportResult result;
   runTransaction(db, [&] {
     result = ImportResult{};
-    writeImport(db, meta, analysis, cloud, cloud_blob ? &*cloud_blob : nullptr, hook, result);
+    writeImport(db, meta, analysis, cloud, cloud_blob ? &*cloud_blob : nullptr, surface_blob ? &*surface_blob : nullptr,
+                hook, result);
   });
   return result;
 }
 
 
-int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis, const std::string& software_version) {
+int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis, const std::string& software_version,
+                    const Mesh* surface) {
   if (!hasSectionsArray(analysis))
     throw InvalidInput("[addAnalysis] the analysis document has no \"sections\" array");
   if (analysis.contains("diagnostics") && !analysis["diagnostics"].is_object())
     throw InvalidInput("[addAnalysis] the analysis document's diagnostics must be an object (got " +
                        std::string(analysis["diagnostics"].type_name()) + ")");
+  const std::optional<std::vector<uint8_t>> surface_blob = surfaceBlob(surface);
   int64_t id = 0;
   runTransaction(db, [&] {
     Statement s = db.prepare("SELECT 1 FROM scans WHERE id = ?");
     s.bind(1, scan_id);
     if (!s.step()) throw InvalidInput("[addAnalysis] no scan with id " + std::to_string(scan_id));
-    id = writeAnalysis(db, scan_id, analysis, software_version, "addAnalysis", nullptr, {});
+    id = writeAnalysis(db, scan_id, analysis, software_version, surface_blob ? &*surface_blob : nullptr, "addAnalysis",
+                       nullptr, {});
   });
   return id;
 }

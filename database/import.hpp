@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/core/cloud.hpp"
+#include "analysis/core/mesh.hpp"
 #include "database/sqlite.hpp"
 
 namespace sailshape {
@@ -50,18 +51,20 @@ struct ImportResult {
 using ImportHook = std::function<void(const std::string& stage)>;
 
 // Stores a scan with an optional analysis document (the JSON of `sailshape
-// analyze --json`) and an optional cloud, in one transaction. Throws
+// analyze --json`), an optional cloud and, with the analysis, the surface it
+// reconstructed (analyses.surface_mesh; reports draw it), in one transaction. Throws
 // InvalidInput for a document without "sections" or bad metadata, DatabaseError
 // (DatabaseBusy when locked) for SQLite failures; nothing is stored then.
 ImportResult importScan(Database& db, const ImportMetadata& meta, const nlohmann::json* analysis,
-                        const Cloud* cloud = nullptr, const ImportHook& hook = {});
+                        const Cloud* cloud = nullptr, const ImportHook& hook = {}, const Mesh* surface = nullptr);
 
 // Stores `analysis` (the JSON of `sailshape analyze --json`) as a new analysis of
-// an existing scan, in one transaction; the scan's earlier analyses stay. Returns
+// an existing scan, with the surface it reconstructed when given, in one
+// transaction; the scan's earlier analyses stay. Returns
 // the analysis id. Throws InvalidInput for a missing scan or a document without
 // a "sections" array or with a fraction outside (0, 1).
 int64_t addAnalysis(Database& db, int64_t scan_id, const nlohmann::json& analysis,
-                    const std::string& software_version = "0.1.0");
+                    const std::string& software_version = "0.1.0", const Mesh* surface = nullptr);
 
 // N×3 float64 little-endian, the layout of sections.curve.
 std::vector<uint8_t> packCurve(const std::vector<Vec3>& curve);

@@ -61,6 +61,7 @@ ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
 
   r.sections.sections = analysisSections(db, r.analysis_id);
   r.sections.unmeasured = unmeasuredSections(db, r.analysis_id);
+  r.surface = analysisSurface(db, r.analysis_id);
   return r;
 }
 
@@ -113,6 +114,13 @@ std::string analysisOutlineJson(Database& db, int64_t analysis_id) {
   Statement s = db.prepare("SELECT sail FROM analyses WHERE id = ?");
   s.bind(1, analysis_id);
   return s.step() && !s.isNull(0) ? s.columnText(0) : std::string();
+}
+
+std::optional<Mesh> analysisSurface(Database& db, int64_t analysis_id) {
+  Statement s = db.prepare("SELECT surface_mesh FROM analyses WHERE id = ?");
+  s.bind(1, analysis_id);
+  if (!s.step() || s.isNull(0)) return std::nullopt;
+  return unpackMesh(s.columnBlob(0));
 }
 
 int64_t latestAnalysisId(Database& db, int64_t scan_id) {

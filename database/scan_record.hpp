@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/core/cloud.hpp"
+#include "analysis/core/mesh.hpp"
 #include "analysis/sections/sections.hpp"
 #include "database/sqlite.hpp"
 
@@ -28,6 +29,7 @@ struct ScanRecord {
   // points are the curve's ends and max_camber_point is not stored (left zero); a
   // parameter stored as NULL (not measurable) is NaN.
   SectionAnalysis sections;
+  std::optional<Mesh> surface;     // the surface that analysis reconstructed, when stored with it (schema 4)
   nlohmann::json analysis_params;  // the pipeline parameters it ran with (null when unknown)
   nlohmann::json settings;         // the acquisition settings stored with the scan (null when none)
   std::optional<Eigen::Matrix4d> registration;  // the latest scanner-to-boat transform, when registered
@@ -57,6 +59,11 @@ std::vector<Section> analysisSections(Database& db, int64_t analysis_id);
 // The outline analysis `analysis_id` stored (analyses.sail: the `sail` object of
 // `sailshape analyze --json`, its luff curve inside) as JSON text; empty when none.
 std::string analysisOutlineJson(Database& db, int64_t analysis_id);
+
+// The surface analysis `analysis_id` reconstructed (analyses.surface_mesh: metres,
+// boat frame); none for an analysis stored without it (imported from its JSON
+// alone, or before schema version 4). Throws DatabaseError for a damaged blob.
+std::optional<Mesh> analysisSurface(Database& db, int64_t analysis_id);
 
 // The sections analysis `analysis_id` was asked for but could not measure, with
 // why (stored in its diagnostics by importScan); empty when there were none.

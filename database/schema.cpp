@@ -121,6 +121,10 @@ CREATE INDEX analyses_scan ON analyses(scan_id);
 CREATE INDEX sections_analysis ON sections(analysis_id, fraction);
 CREATE INDEX design_comparisons_analysis ON design_comparisons(analysis_id);
 )sql",
+    // 4: the surface the analysis reconstructed, so a report draws the sail that was scanned.
+    R"sql(
+ALTER TABLE analyses ADD COLUMN surface_mesh BLOB;  -- catalog.hpp packMesh: metres, boat frame; NULL: not stored
+)sql",
 };
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -27,6 +28,31 @@ void onError(HPDF_STATUS error, HPDF_STATUS detail, void* user) {
     state->error = error;
     state->detail = detail;
   }
+}
+
+// The ToUnicode CMap of a font in libharu's UTF-8 encoding. Its text codes are
+// the characters' UTF-16 code units (CID = code, Identity-H), so each code maps to
+// itself. libharu 2.3 attaches its encoding CMap instead, which maps codes to CIDs
+// (begincidrange), a form a ToUnicode CMap may not use: poppler warns "Invalid
+// 'begincidrange' operator in ToUnicode CMap" for every font on every page. The
+// ranges stay within one high byte, as bfrange requires.
+std::string identityToUnicodeCMap() {
+  std::string cmap =
+      "/CIDInit /ProcSet findresource begin\n12 dict begin\nbegincmap\n"
+      "/CIDSystemInfo << /Registry (Adobe) /Ordering (UCS) /Supplement 0 >> def\n"
+      "/CMapName /Adobe-Identity-UCS def\n/CMapType 2 def\n"
+      "1 begincodespacerange\n<0000> <FFFF>\nendcodespacerange\n";
+  char buf[48];
+  for (int block = 0; block < 256; block += 100) {  // at most 100 entries per bfrange block
+    const int n = std::min(100, 256 - block);
+    cmap += std::to_string(n) + " beginbfrange\n";
+    for (int hi = block; hi < block + n; ++hi) {
+      std::snprintf(buf, sizeof(buf), "<%02X00> <%02XFF> <%02X00>\n", hi, hi, hi);
+      cmap += buf;
+    }
+    cmap += "endbfrange\n";
+  }
+  return cmap + "endcmap\nCMapName currentdict /CMap defineresource pop\nend\nend\n";
 }
 
 std::string hex(unsigned long v) {
@@ -61,6 +87,12 @@ PdfDocument::PdfDocument(const PdfFonts& fonts) : s_(std::make_unique<State>()) 
     PDF_CHECK(s_, "loading font " + path);
     HPDF_Font font = HPDF_GetFont(s_->doc, name, "UTF-8");
     PDF_CHECK(s_, "font " + path + " in UTF-8");
+    auto* to_unicode = static_cast<HPDF_Dict>(HPDF_Dict_GetItem(font, "ToUnicode", HPDF_OCLASS_DICT));
+    if (to_unicode && to_unicode->stream) {
+      HPDF_MemStream_FreeData(to_unicode->stream);
+      HPDF_Stream_WriteStr(to_unicode->stream, identityToUnicodeCMap().c_str());
+      PDF_CHECK(s_, "ToUnicode map of " + path);
+    }
     return font;
   };
   try {

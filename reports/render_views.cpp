@@ -102,7 +102,7 @@ vtkNew<vtkActor> surfaceActor(vtkPolyData* poly) {
 void placeCamera(vtkCamera* camera, View view, const std::vector<Vec3>& points, const PictureSize& size) {
   Vec3 toward, up;  // camera position relative to the focal point; picture up
   switch (view) {
-    case View::Side: toward = Vec3::UnitY(), up = Vec3::UnitZ(); break;     // from port, bow to the right
+    case View::Side: toward = -Vec3::UnitY(), up = Vec3::UnitZ(); break;    // from starboard: +X (bow) to the right
     case View::Top: toward = Vec3::UnitZ(), up = Vec3::UnitX(); break;      // from above, bow up
     case View::Astern: toward = -Vec3::UnitX(), up = Vec3::UnitZ(); break;  // from behind, looking forward
   }

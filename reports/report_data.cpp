@@ -94,6 +94,7 @@ ReportStep loadStep(Database& db, int64_t scan_id, const char* function) {
     throw InvalidInput(std::string("[") + function + "] scan " + std::to_string(scan_id) + " has an analysis without sections");
   step.unmeasured = unmeasuredSections(db, step.analysis_id);
   step.outline = parseOutline(analysisOutlineJson(db, step.analysis_id), step.analysis_id, function);
+  step.surface = analysisSurface(db, step.analysis_id);
   return step;
 }
 

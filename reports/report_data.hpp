@@ -52,6 +52,7 @@ struct ReportStep {
   std::vector<ReportSection> sections;     // the latest analysis, by fraction
   std::vector<UnmeasuredSection> unmeasured;  // sections it was asked for but could not measure, with why
   ReportOutline outline;                   // the latest analysis's (analyses.sail)
+  std::optional<Mesh> surface;             // the surface it reconstructed; none when not stored
   Cloud cloud;                             // the stored cloud; empty when none was stored
 };
 

@@ -13,48 +13,12 @@
 #include "analysis/core/errors.hpp"
 #include "database/schema.hpp"
 #include "reports/private_display.hpp"
+#include "reports/report_layout.hpp"
 
 namespace sailshape {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr float kMargin = 42;
-const Rgb kBlack{0, 0, 0}, kGrey{0.45, 0.45, 0.45}, kLightGrey{0.88, 0.88, 0.88}, kRule{0.75, 0.75, 0.75};
-const Rgb kNavy{0.06, 0.16, 0.33}, kBand{0.93, 0.95, 0.98};
-
-std::string fmt(const char* f, double v) {
-  if (!std::isfinite(v)) return "–";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), f, v);
-  return buf;
-}
-std::string fmtPm(const char* f, double v, double u) {
-  if (!std::isfinite(v)) return "–";
-  return fmt(f, v) + (std::isfinite(u) ? " ± " + fmt(f, std::abs(u)) : "");
-}
-std::string signedFmt(const char* f, double v) {  // '+' sign, and a real minus sign
-  std::string s = fmt(f, v);
-  if (s.find_first_of("123456789") == std::string::npos && (s[0] == '-' || s[0] == '+')) s = s.substr(1);
-  if (!s.empty() && s[0] == '-') s = "−" + s.substr(1);
-  return s;
-}
-
-// Step colours for a test's overlays; the design is always blue.
-Rgb stepColour(size_t i, size_t n) {
-  static const Rgb palette[] = {{0.85, 0.12, 0.10}, {0.95, 0.55, 0.05}, {0.55, 0.15, 0.65},
-                                {0.10, 0.60, 0.30}, {0.45, 0.30, 0.15}, {0.90, 0.30, 0.60}};
-  if (n == 1) return kFlyingRed;
-  return palette[i % (sizeof(palette) / sizeof(palette[0]))];
-}
-
-// A round number at or above v for axis ranges and the colour map: 1, 2, 2.5, 5 × 10^k.
-double niceCeil(double v) {
-  if (!(v > 0)) return 1;
-  const double e = std::pow(10.0, std::floor(std::log10(v)));
-  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
-    if (m * e >= v * (1 - 1e-9)) return m * e;
-  return 10 * e;
-}
+using namespace layout;
 
 std::vector<Vec3> resampleByArc(const std::vector<Vec3>& curve, int n) {
   std::vector<double> s(curve.size(), 0.0);
@@ -72,131 +36,6 @@ std::vector<Vec3> resampleByArc(const std::vector<Vec3>& curve, int n) {
 }
 
 // A section curve in its own chord frame, divided by the chord: x from luff (0)
-// to leech (1), y the depth to the side the curve bulges to.
-std::vector<std::pair<double, double>> chordProfile(const std::vector<Vec3>& curve) {
-  std::vector<std::pair<double, double>> out;
-  if (curve.size() < 3) return out;
-  const Vec3 L = curve.front(), R = curve.back();
-  const double chord = (R - L).norm();
-  if (chord <= 0) return out;
-  const Vec3 c = (R - L) / chord;
-  Vec3 deepest = Vec3::Zero();
-  for (const Vec3& p : curve) {
-    const Vec3 off = (p - L) - (p - L).dot(c) * c;
-    if (off.norm() > deepest.norm()) deepest = off;
-  }
-  if (deepest.norm() <= 0) return out;
-  const Vec3 y = deepest.normalized();
-  for (const Vec3& p : curve) out.emplace_back((p - L).dot(c) / chord, (p - L).dot(y) / chord);
-  return out;
-}
-
-struct Series {
-  std::string label;
-  Rgb colour;
-  bool dashed = false;
-  std::vector<double> y, x, sigma;  // y: height fraction; x: value; sigma: 1σ of x (NaN: none)
-};
-
-void axisTicks(double lo, double hi, std::vector<double>& ticks) {
-  const double step = niceCeil((hi - lo) / 5);
-  for (double t = std::ceil(lo / step) * step; t <= hi + 1e-9 * step; t += step) ticks.push_back(t);
-}
-
-// A parameter against height: x the value, y the height fraction (up the page).
-void profilePlot(PdfDocument& pdf, float x0, float y0, float w, float h, const std::string& title,
-                 const std::vector<Series>& series, const char* tick_format) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const auto& s : series)
-    for (size_t i = 0; i < s.x.size(); ++i) {
-      if (!std::isfinite(s.x[i])) continue;
-      const double u = std::isfinite(s.sigma[i]) ? s.sigma[i] : 0.0;
-      lo = std::min(lo, s.x[i] - u);
-      hi = std::max(hi, s.x[i] + u);
-    }
-  if (!std::isfinite(lo)) lo = 0, hi = 1;
-  const double pad = std::max(0.08 * (hi - lo), 0.5);
-  lo -= pad;
-  hi += pad;
-  const float px = x0 + 30, pw = w - 38, py = y0 + 20, ph = h - 50;
-  pdf.text(x0 + w / 2, y0 + 10, title, 10, true, kNavy, Align::Centre);
-  auto X = [&](double v) { return float(px + (v - lo) / (hi - lo) * pw); };
-  auto Y = [&](double f) { return float(py + ph - f * ph); };
-  for (double f = 0; f <= 1.0001; f += 0.25) {
-    pdf.line(px, Y(f), px + pw, Y(f), 0.4f, kLightGrey);
-    pdf.text(px - 4, Y(f) + 3, fmt("%.0f", 100 * f), 7, false, kGrey, Align::Right);
-  }
-  std::vector<double> ticks;
-  axisTicks(lo, hi, ticks);
-  for (double t : ticks) {
-    pdf.line(X(t), py, X(t), py + ph, 0.4f, kLightGrey);
-    pdf.text(X(t), py + ph + 10, signedFmt(tick_format, t), 7, false, kGrey, Align::Centre);
-  }
-  pdf.frame(px, py, pw, ph, 0.6f, kRule);
-  for (const auto& s : series) {
-    std::vector<std::pair<float, float>> line;
-    for (size_t i = 0; i < s.x.size(); ++i) {
-      if (!std::isfinite(s.x[i])) continue;
-      line.emplace_back(X(s.x[i]), Y(s.y[i]));
-      if (std::isfinite(s.sigma[i]) && s.sigma[i] > 0) {
-        pdf.line(X(s.x[i] - s.sigma[i]), Y(s.y[i]), X(s.x[i] + s.sigma[i]), Y(s.y[i]), 0.8f, s.colour);
-        pdf.line(X(s.x[i] - s.sigma[i]), Y(s.y[i]) - 2, X(s.x[i] - s.sigma[i]), Y(s.y[i]) + 2, 0.8f, s.colour);
-        pdf.line(X(s.x[i] + s.sigma[i]), Y(s.y[i]) - 2, X(s.x[i] + s.sigma[i]), Y(s.y[i]) + 2, 0.8f, s.colour);
-      }
-    }
-    pdf.polyline(line, 1.4f, s.colour, s.dashed);
-    for (const auto& [lx, ly] : line) pdf.disc(lx, ly, 1.8f, s.colour);
-  }
-}
-
-void legendRow(PdfDocument& pdf, float x, float y, const std::vector<Series>& series) {
-  for (const auto& s : series) {
-    pdf.line(x, y - 3, x + 18, y - 3, 1.6f, s.colour, s.dashed);
-    pdf.text(x + 22, y, s.label, 8.5f);
-    x += 22 + pdf.textWidth(s.label, 8.5f) + 16;
-  }
-}
-
-class Pages {
- public:
-  Pages(PdfDocument& pdf, const ReportData& d) : pdf_(pdf), d_(d) {}
-  // A new page with the header band; returns the y where content starts.
-  float start(const std::string& title, bool landscape = false) {
-    pdf_.addPage(landscape);
-    const float w = pdf_.pageWidth(), h = pdf_.pageHeight();
-    pdf_.rect(0, 0, w, 34, kNavy);
-    // The title shrinks (to 10 pt) to keep clear of the sail and boat on the right;
-    // when it still does not fit, the sail and boat go up to the band's top line.
-    const std::string who = d_.sail + (d_.boat.empty() ? "" : " · " + d_.boat);
-    const float room = w - 2 * kMargin - pdf_.textWidth(who, 9) - 12;
-    float size = 13;
-    while (size > 10 && pdf_.textWidth(title, size, true) > room) size -= 0.5f;
-    const bool beside = pdf_.textWidth(title, size, true) <= room;
-    pdf_.text(kMargin, beside ? 22 : 27, title, size, true, {1, 1, 1});
-    pdf_.text(w - kMargin, beside ? 22 : 11, who, beside ? 9 : 7.5f, false, {0.85, 0.9, 1}, Align::Right);
-    pdf_.line(kMargin, h - 28, w - kMargin, h - 28, 0.4f, kRule);
-    pdf_.text(kMargin, h - 16, "sailshape trim report · " + d_.campaign + (d_.test.empty() ? "" : " · test " + d_.test),
-              7.5f, false, kGrey);
-    pdf_.text(w - kMargin, h - 16, "page " + std::to_string(pdf_.pageCount()), 7.5f, false, kGrey, Align::Right);
-    return 58;
-  }
-
- private:
-  PdfDocument& pdf_;
-  const ReportData& d_;
-};
-
-std::string stepLabel(const ReportData& d, const ReportStep& s) {
-  if (d.steps.size() == 1 && d.test.empty()) return "scan " + std::to_string(s.scan_id);
-  return "step " + std::to_string(s.step_order);
-}
-
-std::string conditions(const ReportStep& s) {
-  std::string out;
-  if (s.awa_deg) out += "AWA " + fmt("%.1f°", *s.awa_deg);
-  if (s.aws_m_s) out += (out.empty() ? "" : ", ") + std::string("AWS ") + fmt("%.1f m/s", *s.aws_m_s);
-  return out.empty() ? "wind not recorded" : out;
-}
 
 std::string today() {
   const std::time_t now = std::time(nullptr);
@@ -314,7 +153,7 @@ void viewsPage(PdfDocument& pdf, Pages& pages, const ReportData& d, const Report
     pdf.text(x + w / 2, top + h + 12, caption, 8.5f, false, kBlack, Align::Centre);
   };
   float x = kMargin;
-  place(v.side, x, y, L.side_w, L.row1_h, "From the side (port), bow to the right");
+  place(v.side, x, y, L.side_w, L.row1_h, "From the side (starboard), bow to the right");
   x += L.side_w + L.gap;
   place(v.astern, x, y, L.astern_w, L.row1_h, "From astern");
   x += L.astern_w + L.gap;
@@ -331,7 +170,10 @@ void viewsPage(PdfDocument& pdf, Pages& pages, const ReportData& d, const Report
   pdf.text(lx + 24, ly, "design, as a grid", 8.5f);
   ly += 14;
   pdf.rect(lx, ly - 8, 18, 8, kFlyingRed);
-  ly = pdf.paragraph(lx + 24, ly, lw - 24, "flying shape, lofted through the measured sections", 8.5f) + 14;
+  ly = pdf.paragraph(lx + 24, ly, lw - 24,
+                     c.lofted ? "flying shape, lofted through the measured sections (the scan's surface was not stored)"
+                              : "flying shape, the surface reconstructed from the scan",
+                     8.5f) + 14;
   pdf.text(lx, ly, "Deviation, mm", 9.5f, true, kNavy);
   ly += 10;
   const float bh = 10;
@@ -374,21 +216,43 @@ float outlineTable(PdfDocument& pdf, float y, const ReportOutline& design, const
     const char* label;
     OutlineMeasure ReportOutline::*field;
     const char* format;
+    OutlineMeasure ReportOutline::*sag = nullptr;  // a sag, or the sag a position belongs to
   };
   const Row rows[] = {{"Luff length, m", &ReportOutline::luff_length_m, "%.3f"},
                       {"Leech length, m", &ReportOutline::leech_length_m, "%.3f"},
                       {"Foot length, m", &ReportOutline::foot_length_m, "%.3f"},
                       {"Top length (square top), m", &ReportOutline::top_length_m, "%.3f"},
                       {"Area, m²", &ReportOutline::area_m2, "%.2f"},
-                      {"Luff sag in the sail's plane (LUFA), %", &ReportOutline::lufa_sag_pct, "%.2f"},
-                      {"   its height up the luff, %", &ReportOutline::lufa_position_pct, "%.0f"},
-                      {"Luff sag across it, to port (LUSW), %", &ReportOutline::lusw_sag_pct, "%.2f"},
-                      {"   its height up the luff, %", &ReportOutline::lusw_position_pct, "%.0f"}};
+                      {"Luff sag in the sail's plane (LUFA), %", &ReportOutline::lufa_sag_pct, "%.2f",
+                       &ReportOutline::lufa_sag_pct},
+                      {"   its height up the luff, %", &ReportOutline::lufa_position_pct, "%.0f",
+                       &ReportOutline::lufa_sag_pct},
+                      {"Luff sag across it, to port (LUSW), %", &ReportOutline::lusw_sag_pct, "%.2f",
+                       &ReportOutline::lusw_sag_pct},
+                      {"   its height up the luff, %", &ReportOutline::lusw_position_pct, "%.0f",
+                       &ReportOutline::lusw_sag_pct}};
   auto cell = [](const char* f, double v, double u, bool diff) {
     if (!std::isfinite(v)) return std::string("–");
     std::string out = signedFmt(diff ? ("%+" + std::string(f + 1)).c_str() : f, v);
     if (std::isfinite(u)) out += " ± " + fmt(f, std::abs(u));
     return out;
+  };
+  // A sag within 2σ of zero is not a sag the scan found (the summary's threshold,
+  // SummaryParams::min_sigmas): it reads "none", and where along the luff it stands
+  // is no result either; nor is a position whose σ exceeds it.
+  auto resolved = [](const OutlineMeasure& sag) {
+    return std::isfinite(sag.value) && !(std::isfinite(sag.sigma) && std::abs(sag.value) <= 2 * sag.sigma);
+  };
+  auto isResult = [&](const Row& r, const ReportOutline& o) {
+    const OutlineMeasure& m = o.*r.field;
+    if (!r.sag || !std::isfinite(m.value)) return true;
+    if (!resolved(o.*r.sag)) return false;
+    return r.sag == r.field || !(std::isfinite(m.sigma) && m.sigma >= std::abs(m.value));
+  };
+  auto shown = [&](const Row& r, const ReportOutline& o) -> std::string {
+    const OutlineMeasure& m = o.*r.field;
+    if (!isResult(r, o)) return r.sag == r.field ? "none (± " + fmt(r.format, m.sigma) + ")" : "–";
+    return cell(r.format, m.value, m.sigma, false);
   };
   int band = 0;
   for (const Row& r : rows) {
@@ -396,18 +260,21 @@ float outlineTable(PdfDocument& pdf, float y, const ReportOutline& design, const
     if (!std::isfinite(a.value) && !std::isfinite(b.value)) continue;  // e.g. no top edge
     if (band++ % 2) pdf.rect(kMargin, y - 10, w - 2 * kMargin, 14, kBand);
     pdf.text(col[0], y, r.label, 8.5f, false, kBlack);
-    pdf.text(col[1], y, cell(r.format, a.value, a.sigma, false), 8.5f, false, kDesignBlue, Align::Right);
-    pdf.text(col[2], y, cell(r.format, b.value, b.sigma, false), 8.5f, false, kFlyingRed, Align::Right);
+    pdf.text(col[1], y, shown(r, design), 8.5f, false, kDesignBlue, Align::Right);
+    pdf.text(col[2], y, shown(r, flying), 8.5f, false, kFlyingRed, Align::Right);
     const double du = std::isfinite(a.sigma) || std::isfinite(b.sigma)
                           ? std::hypot(std::isfinite(a.sigma) ? a.sigma : 0.0, std::isfinite(b.sigma) ? b.sigma : 0.0)
                           : kNaN;
-    pdf.text(col[3], y, cell(r.format, b.value - a.value, du, true), 8.5f, true, kBlack, Align::Right);
+    // Two positions compare only where both sags were found.
+    const bool comparable = !r.sag || r.sag == r.field || (isResult(r, design) && isResult(r, flying));
+    pdf.text(col[3], y, comparable ? cell(r.format, b.value - a.value, du, true) : "–", 8.5f, true, kBlack,
+             Align::Right);
     y += 14;
   }
   y += 4;
   std::string note =
       "Sags are the luff's largest offset from the straight line tack to head, as % of that line's length; in the "
-      "sail's plane + is away from the clew.";
+      "sail's plane + is away from the clew. A sag within 2σ of zero reads \"none\"; a height whose σ exceeds it is not given.";
   if (flying.beam_footprint_m > 0)
     note += " The flying edges were moved out " + fmt("%.1f", 100 * flying.beam_footprint_m) +
             " cm for the scanner's beam: a return lies on the sail only while the whole beam does.";
@@ -498,264 +365,6 @@ void tablePage(PdfDocument& pdf, Pages& pages, const ReportData& d, const Report
   outlineTable(pdf, y + 14, design_outline, step.outline);
 }
 
-std::vector<Series> parameterSeries(const TrimReportData& r, double SectionParameters::*field, bool with_design) {
-  std::vector<Series> out;
-  const auto& d = r.data;
-  if (with_design) {
-    Series s{"design", kDesignBlue, true, {}, {}, {}};
-    for (const Section& ds : r.design_sections.sections) {
-      s.y.push_back(ds.fraction);
-      s.x.push_back(ds.value.*field);
-      s.sigma.push_back(kNaN);
-    }
-    out.push_back(std::move(s));
-  }
-  for (size_t i = 0; i < d.steps.size(); ++i) {
-    Series s{d.steps.size() == 1 ? "flying" : stepLabel(d, d.steps[i]), stepColour(i, d.steps.size()), false, {}, {}, {}};
-    for (const ReportSection& fs : d.steps[i].sections) {
-      s.y.push_back(fs.fraction);
-      s.x.push_back(fs.value.*field);
-      s.sigma.push_back(fs.uncertainty.*field);
-    }
-    out.push_back(std::move(s));
-  }
-  return out;
-}
-
-void plotsPage(PdfDocument& pdf, Pages& pages, const TrimReportData& r, bool crew) {
-  float y = pages.start("Camber, draft and twist up the sail");
-  const float w = pdf.pageWidth();
-  const std::vector<Series> camber = parameterSeries(r, &SectionParameters::camber_pct, true);
-  legendRow(pdf, kMargin, y + 4, camber);
-  y += 20;
-  const float pw = (w - 2 * kMargin) / 3, ph = 430;
-  profilePlot(pdf, kMargin, y, pw, ph, "Camber, % of chord", camber, "%.0f");
-  profilePlot(pdf, kMargin + pw, y, pw, ph, "Draft, % of chord from luff",
-              parameterSeries(r, &SectionParameters::draft_pct, true), "%.0f");
-  profilePlot(pdf, kMargin + 2 * pw, y, pw, ph, "Twist, ° to centreline",
-              parameterSeries(r, &SectionParameters::twist_deg, true), "%.0f");
-  y += ph + 8;
-  pdf.text(kMargin, y, "Vertical axis: height, % of luff. Bars: ±1σ of the measurement.", 8.5f, false, kGrey);
-  y += 20;
-  const std::string text =
-      crew ? "Deeper than the blue line means more power than designed; draft to the right means the deepest point "
-             "has moved aft; twist to the right means the sail is more open (twisted off) than designed."
-           : "Design values from the design surface analysed at the flying heights (dashed); flying values as stored "
-             "with their 1σ. Twist is the chord's angle to the centreline in the horizontal plane (SPEC §5).";
-  pdf.paragraph(kMargin, y, w - 2 * kMargin, text, 9.5f);
-}
-
-void curvesPage(PdfDocument& pdf, Pages& pages, const TrimReportData& r) {
-  float y = pages.start("Section shapes, flying over design");
-  const float w = pdf.pageWidth();
-  std::vector<Series> legend = {{"design", kDesignBlue, true, {}, {}, {}}};
-  const auto& d = r.data;
-  for (size_t i = 0; i < d.steps.size(); ++i)
-    legend.push_back({d.steps.size() == 1 ? "flying" : stepLabel(d, d.steps[i]), stepColour(i, d.steps.size()), false,
-                      {}, {}, {}});
-  legendRow(pdf, kMargin, y + 4, legend);
-  pdf.text(w - kMargin, y + 4, "depth drawn 2× its true scale", 8.5f, false, kGrey, Align::Right);
-  y += 18;
-  const auto& fractions = r.design_sections.sections;
-  const size_t n = fractions.size();
-  const int cols = n > 4 ? 2 : 1;
-  const int rows = static_cast<int>((n + cols - 1) / cols);
-  const float cw = (w - 2 * kMargin - (cols - 1) * 14) / cols;
-  const float ch = std::min(150.f, (pdf.pageHeight() - y - 50) / rows);
-  for (size_t k = 0; k < n; ++k) {
-    const size_t idx = n - 1 - k;  // head first
-    const double f = fractions[idx].fraction;
-    const float x0 = kMargin + (k % cols) * (cw + 14), y0 = y + (k / cols) * ch;
-    pdf.text(x0, y0 + 10, fmt("%.0f %% height", 100 * f) + " · " + heightName(f), 9, true, kNavy);
-    const float px = x0 + 4, pw = cw - 8, base = y0 + ch - 16;
-    const float scale = pw;  // points per chord
-    const float exaggerate = 2.0f;
-    pdf.line(px, base, px + pw, base, 0.5f, kRule, true);  // the chord
-    auto draw = [&](const std::vector<Vec3>& curve, const Rgb& colour, bool dashed) {
-      std::vector<std::pair<float, float>> line;
-      for (const auto& [u, v] : chordProfile(curve)) line.emplace_back(px + u * scale, base - exaggerate * v * scale);
-      pdf.polyline(line, 1.3f, colour, dashed);
-    };
-    draw(fractions[idx].curve, kDesignBlue, true);
-    for (size_t i = 0; i < d.steps.size(); ++i)
-      for (const ReportSection& s : d.steps[i].sections)
-        if (std::abs(s.fraction - f) < 1e-6) draw(s.curve, stepColour(i, d.steps.size()), false);
-    pdf.text(px, base + 10, "luff", 7, false, kGrey);
-    pdf.text(px + pw, base + 10, "leech", 7, false, kGrey, Align::Right);
-  }
-}
-
-// Table of steps: conditions, controls, forces; each with its change from the
-// previous step below. Returns the y below the table.
-float stepsTable(PdfDocument& pdf, float y, const ReportData& d, const std::set<std::string>& control_names) {
-  const float w = pdf.pageWidth();
-  std::vector<std::string> heads = {"Step", "AWA °", "AWS m/s"};
-  for (const auto& c : control_names) heads.push_back(c);
-  heads.insert(heads.end(), {"Drive N", "Side N", "Heel N·m"});
-  const float cw = (w - 2 * kMargin) / heads.size();
-  pdf.rect(kMargin, y - 12, w - 2 * kMargin, 18, kNavy);
-  for (size_t k = 0; k < heads.size(); ++k)
-    pdf.text(kMargin + cw * (k + 1) - 4, y, heads[k], 8.5f, true, {1, 1, 1}, Align::Right);
-  y += 18;
-  auto value = [&](const ReportStep& s, size_t k) -> double {
-    if (k == 1) return s.awa_deg.value_or(kNaN);
-    if (k == 2) return s.aws_m_s.value_or(kNaN);
-    if (k < 3 + control_names.size()) {
-      auto it = std::next(control_names.begin(), long(k - 3));
-      auto f = s.controls.find(*it);
-      return f == s.controls.end() ? kNaN : f->second;
-    }
-    const size_t j = k - 3 - control_names.size();
-    return (j == 0 ? s.drive_n : j == 1 ? s.side_n : s.heel_moment_nm).value_or(kNaN);
-  };
-  for (size_t i = 0; i < d.steps.size(); ++i) {
-    const ReportStep& s = d.steps[i];
-    pdf.rect(kMargin, y - 11, w - 2 * kMargin, 26, (i % 2) ? Rgb{1, 1, 1} : kBand);
-    pdf.disc(kMargin + 6, y - 3, 3, stepColour(i, d.steps.size()));
-    pdf.text(kMargin + cw - 4, y, std::to_string(s.step_order), 9, true, kBlack, Align::Right);
-    for (size_t k = 1; k < heads.size(); ++k) {
-      const bool control = k >= 3 && k < 3 + control_names.size();
-      pdf.text(kMargin + cw * (k + 1) - 4, y, fmt(control ? "%.3g" : k <= 2 ? "%.1f" : "%.0f", value(s, k)), 9, false,
-               kBlack, Align::Right);
-      if (i > 0)
-        pdf.text(kMargin + cw * (k + 1) - 4, y + 11,
-                 "Δ " + signedFmt(control ? "%+.3g" : k <= 2 ? "%+.1f" : "%+.0f", value(s, k) - value(d.steps[i - 1], k)),
-                 7.5f, false, kGrey, Align::Right);
-    }
-    y += 28;
-  }
-  return y;
-}
-
-// Which step pulled best, when forces were measured; returns the y below it.
-float bestStepLine(PdfDocument& pdf, float y, const ReportData& d) {
-  const ReportStep* most_drive = nullptr;
-  const ReportStep* best_ratio = nullptr;
-  for (const auto& s : d.steps) {
-    if (s.drive_n && (!most_drive || *s.drive_n > *most_drive->drive_n)) most_drive = &s;
-    if (s.drive_n && s.side_n && *s.side_n > 0 &&
-        (!best_ratio || *s.drive_n / *s.side_n > *best_ratio->drive_n / *best_ratio->side_n))
-      best_ratio = &s;
-  }
-  if (!most_drive) return y;
-  std::string best = "Most drive: " + stepLabel(d, *most_drive) + " (" + fmt("%.0f N", *most_drive->drive_n) + ")";
-  if (best_ratio)
-    best += "; best drive for its side force: " + stepLabel(d, *best_ratio) + " (drive/side " +
-            fmt("%.2f", *best_ratio->drive_n / *best_ratio->side_n) + ")";
-  return pdf.paragraph(kMargin, y + 4, pdf.pageWidth() - 2 * kMargin, best + ".", 9.5f, true, kNavy);
-}
-
-// Controls that moved from step a to step b, and the force changes, in words.
-std::string controlsAndForcesInWords(const ReportStep& a, const ReportStep& b,
-                                     const std::set<std::string>& control_names) {
-  std::string moved;
-  for (const auto& c : control_names) {
-    const auto fa = a.controls.find(c), fb = b.controls.find(c);
-    if (fa == a.controls.end() || fb == b.controls.end() || fa->second == fb->second) continue;
-    moved += (moved.empty() ? "" : ", ") + c + " " + fmt("%.3g", fa->second) + " → " + fmt("%.3g", fb->second);
-  }
-  std::string forces;
-  if (a.drive_n && b.drive_n) forces += "drive " + signedFmt("%+.0f", *b.drive_n - *a.drive_n) + " N";
-  if (a.side_n && b.side_n) forces += (forces.empty() ? "" : ", ") + std::string("side ") + signedFmt("%+.0f", *b.side_n - *a.side_n) + " N";
-  if (a.heel_moment_nm && b.heel_moment_nm)
-    forces += (forces.empty() ? "" : ", ") + std::string("heel ") + signedFmt("%+.0f", *b.heel_moment_nm - *a.heel_moment_nm) + " N·m";
-  return "Controls: " + (moved.empty() ? std::string("no change recorded") : moved) + ". Forces: " +
-         (forces.empty() ? std::string("not measured") : forces) + ".";
-}
-
-// The same section in two steps (matched by fraction).
-struct SectionPair {
-  const ReportSection *a, *b;
-};
-
-std::vector<SectionPair> matchSections(const ReportStep& a, const ReportStep& b) {
-  std::vector<SectionPair> pairs;
-  for (const auto& sb : b.sections)
-    for (const auto& sa : a.sections)
-      if (std::abs(sa.fraction - sb.fraction) < 1e-6) pairs.push_back({&sa, &sb});
-  return pairs;
-}
-
-// For the crew: camber, draft and twist changes as their mean over the
-// sections and the largest one with where it is.
-std::string shapeChangeInWords(const std::vector<SectionPair>& pairs) {
-  const char* label[3] = {"camber", "draft", "twist"};
-  double SectionParameters::*fields[3] = {&SectionParameters::camber_pct, &SectionParameters::draft_pct,
-                                          &SectionParameters::twist_deg};
-  const char* unit[3] = {" % of chord", " % of chord", "°"};
-  std::string words;
-  for (int k = 0; k < 3; ++k) {
-    double sum = 0, best = 0, best_f = 0;
-    int n = 0;
-    for (const auto& p : pairs) {
-      const double dv = p.b->value.*fields[k] - p.a->value.*fields[k];
-      if (!std::isfinite(dv)) continue;
-      sum += dv, ++n;
-      if (std::abs(dv) > std::abs(best)) best = dv, best_f = p.b->fraction;
-    }
-    if (!n) continue;
-    // Changes below half a tenth do not print as a change at one decimal.
-    if (std::abs(best) < 0.05) {
-      words += std::string(words.empty() ? "" : "; ") + label[k] + " unchanged";
-      continue;
-    }
-    words += std::string(words.empty() ? "" : "; ") + label[k] + " " + signedFmt("%+.1f", sum / n) + unit[k] +
-             " on average, most at the " + heightName(best_f) + " (" + signedFmt("%+.1f", best) + unit[k] + ")";
-  }
-  return "Shape: " + words + ".";
-}
-
-// For the designer: every parameter's change per section ± its 1σ (the two
-// steps' σ in quadrature), head at the top. Returns the y below the table.
-float sectionChangeTable(PdfDocument& pdf, float y, const std::vector<SectionPair>& pairs) {
-  const float w = pdf.pageWidth();
-  const char* h2[] = {"Height", "Δ camber %", "Δ draft %", "Δ twist °", "Δ entry °", "Δ exit °"};
-  const float c2 = (w - 2 * kMargin) / 6;
-  pdf.rect(kMargin, y - 10, w - 2 * kMargin, 15, kLightGrey);
-  for (int k = 0; k < 6; ++k) pdf.text(kMargin + c2 * (k + 1) - 4, y, h2[k], 8, true, kBlack, Align::Right);
-  y += 14;
-  for (size_t q = pairs.size(); q-- > 0;) {
-    const auto& p = pairs[q];
-    pdf.text(kMargin + c2 - 4, y, fmt("%.0f %%", 100 * p.b->fraction), 8, false, kBlack, Align::Right);
-    double SectionParameters::*fields[5] = {&SectionParameters::camber_pct, &SectionParameters::draft_pct,
-                                            &SectionParameters::twist_deg, &SectionParameters::entry_deg,
-                                            &SectionParameters::exit_deg};
-    for (int k = 0; k < 5; ++k) {
-      const double dv = p.b->value.*fields[k] - p.a->value.*fields[k];
-      const double du = std::hypot(p.b->uncertainty.*fields[k], p.a->uncertainty.*fields[k]);
-      const char* f = k == 0 ? "%+.2f" : "%+.1f";
-      std::string cell = std::isfinite(dv) ? signedFmt(f, dv) : "–";
-      if (std::isfinite(dv) && std::isfinite(du)) cell += " ± " + fmt(k == 0 ? "%.2f" : "%.1f", du);
-      pdf.text(kMargin + c2 * (k + 2) - 4, y, cell, 8, false, kBlack, Align::Right);
-    }
-    y += 12;
-  }
-  return y;
-}
-
-void changesPage(PdfDocument& pdf, Pages& pages, const TrimReportData& r, bool crew) {
-  const ReportData& d = r.data;
-  float y = pages.start("Trim steps: what changed");
-  const float w = pdf.pageWidth();
-  std::set<std::string> control_names;
-  for (const auto& s : d.steps)
-    for (const auto& [k, v] : s.controls) control_names.insert(k);
-  y = stepsTable(pdf, y, d, control_names);
-  y = bestStepLine(pdf, y, d) + 12;
-  for (size_t i = 1; i < d.steps.size(); ++i) {
-    const ReportStep &a = d.steps[i - 1], &b = d.steps[i];
-    pdf.text(kMargin, y, stepLabel(d, a) + " → " + stepLabel(d, b), 11, true, kNavy);
-    y += 16;
-    y = pdf.paragraph(kMargin, y, w - 2 * kMargin, controlsAndForcesInWords(a, b, control_names), 9.5f) + 2;
-    const std::vector<SectionPair> pairs = matchSections(a, b);
-    if (crew) {
-      y = pdf.paragraph(kMargin, y, w - 2 * kMargin, shapeChangeInWords(pairs), 9.5f) + 10;
-      continue;
-    }
-    y = sectionChangeTable(pdf, y, pairs) + 12;
-    if (y > pdf.pageHeight() - 140 && i + 1 < d.steps.size()) y = pages.start("Trim steps: what changed (continued)");
-  }
-}
 
 void requireWritable(const std::string& out) {
   if (out.empty()) throw InvalidInput("[writeTrimReport] no output file given");
@@ -852,15 +461,23 @@ TrimReportData prepareTrimReport(const TrimReportParams& p, const Progress& prog
         if (std::abs(ds.fraction - fs.fraction) < 1e-9) cs.design = ds.value, cs.design_u = ds.uncertainty;
       c.sections.push_back(cs);
     }
-    if (step.sections.size() < 2) {
-      std::string gone;
-      for (const UnmeasuredSection& u : step.unmeasured) gone += (gone.empty() ? "" : ", ") + fmt("%.0f %%", 100 * u.fraction);
-      throw InvalidInput("[writeTrimReport] scan " + std::to_string(step.scan_id) + " has " +
-                         std::to_string(step.sections.size()) + " measured section" +
-                         (gone.empty() ? "" : " (not measured: " + gone + ")") +
-                         "; its flying surface needs at least two");
+    if (step.surface && !step.surface->empty()) {
+      c.flying_surface = *step.surface;
+    } else {
+      // Scans stored before their analysis kept its surface (schema version 4), or
+      // imported from the analysis JSON alone: the section curves stand in for it.
+      if (step.sections.size() < 2) {
+        std::string gone;
+        for (const UnmeasuredSection& u : step.unmeasured)
+          gone += (gone.empty() ? "" : ", ") + fmt("%.0f %%", 100 * u.fraction);
+        throw InvalidInput("[writeTrimReport] scan " + std::to_string(step.scan_id) + " has " +
+                           std::to_string(step.sections.size()) + " measured section" +
+                           (gone.empty() ? "" : " (not measured: " + gone + ")") +
+                           " and no stored surface; its flying surface needs at least two");
+      }
+      c.flying_surface = loftSections(step.sections);
+      c.lofted = true;
     }
-    c.flying_surface = loftSections(step.sections);
     c.deviation_m = signedDistances(distance, c.flying_surface.vertices);
     c.deviation = distanceStats(c.deviation_m);
     r.steps.push_back(std::move(c));
@@ -879,11 +496,14 @@ TrimReport writeTrimReport(const TrimReportParams& p, const Progress& progress) 
   const TrimReportData& r = out.content;
   const bool crew = p.audience == "crew";
 
-  // Each step's colour scale spans its own 5–95 % deviations (at least ±5 mm,
-  // about the sensor's σ, SPEC §3): a step close to the design still shows where it differs.
-  auto rangeOf = [](const StepComparison& c) {
-    return niceCeil(std::max({std::abs(c.deviation.p5_m), std::abs(c.deviation.p95_m), 0.005}) * 1000) / 1000;
-  };
+  // One colour scale for the whole report, so a colour means the same millimetres on
+  // every page: it spans the largest 5–95 % deviation of any step (at least ±5 mm,
+  // about the sensor's σ, SPEC §3).
+  double spread_m = 0.005;
+  for (const StepComparison& c : r.steps)
+    spread_m = std::max({spread_m, std::abs(c.deviation.p5_m), std::abs(c.deviation.p95_m)});
+  const double range_m = niceCeil(spread_m * 1000) / 1000;
+  out.deviation_range_m = range_m;
 
   progress("rendering", 0);
   std::vector<SailViews> views;
@@ -891,9 +511,9 @@ TrimReport writeTrimReport(const TrimReportParams& p, const Progress& progress) 
     PrivateDisplay display;
     out.private_display = display.started();
     RenderParams rp = p.render;
+    rp.deviation_range_m = range_m;
     const size_t first = crew ? r.steps.size() - 1 : 0;
     for (size_t i = first; i < r.steps.size(); ++i) {
-      rp.deviation_range_m = rangeOf(r.steps[i]);
       views.push_back(renderSailViews(*r.data.design_mesh, r.steps[i].flying_surface, r.steps[i].deviation_m, rp));
       progress("rendering", double(i + 1 - first) / (r.steps.size() - first));
     }
@@ -907,10 +527,10 @@ TrimReport writeTrimReport(const TrimReportParams& p, const Progress& progress) 
   coverPage(pdf, pages, r, crew);
   const ReportData& d = r.data;
   if (crew) {
-    viewsPage(pdf, pages, d, d.steps.back(), r.steps.back(), views.back(), rangeOf(r.steps.back()));
+    viewsPage(pdf, pages, d, d.steps.back(), r.steps.back(), views.back(), range_m);
     plotsPage(pdf, pages, r, true);
   } else {
-    for (size_t i = 0; i < d.steps.size(); ++i) viewsPage(pdf, pages, d, d.steps[i], r.steps[i], views[i], rangeOf(r.steps[i]));
+    for (size_t i = 0; i < d.steps.size(); ++i) viewsPage(pdf, pages, d, d.steps[i], r.steps[i], views[i], range_m);
     for (size_t i = 0; i < d.steps.size(); ++i) tablePage(pdf, pages, d, d.steps[i], r.steps[i], r.design_outline);
     plotsPage(pdf, pages, r, false);
     curvesPage(pdf, pages, r);

@@ -41,7 +41,8 @@ struct TrimReportParams {
 // Design against flying at the flying sections' fractions, per trim step.
 struct StepComparison {
   std::vector<ComparedSection> sections;  // by fraction
-  Mesh flying_surface;                    // lofted through the measured section curves
+  Mesh flying_surface;                    // the analysis's reconstructed surface, or lofted through the section curves
+  bool lofted = false;                    // the analysis stored no surface: the loft stands in for it
   std::vector<double> deviation_m;        // per flying_surface vertex, signed, + to leeward
   DistanceStats deviation;
 };
@@ -64,6 +65,7 @@ struct TrimReport {
   std::string out_path;
   int pages = 0;
   bool private_display = false;  // an Xvfb was started for the renders
+  double deviation_range_m = 0;  // the ± limit of the report's one deviation colour scale
   TrimReportData content;
 };
 

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "database/sqlite.hpp"
 #include "viewer/catalog_tree.hpp"
 #include "viewer/live_mode.hpp"
@@ -21,6 +23,7 @@
 #include "viewer/scan_scene.hpp"
 #include "viewer/scanner_session.hpp"
 #include "viewer/section_table.hpp"
+#include "viewer/unit_camera.hpp"
 #include "viewer/vtk_viewport.hpp"
 #include "viewer/worker.hpp"
 
@@ -163,8 +166,12 @@ class App {
   bool startLive();
   void storeLiveSweeps(bool on) { live_.save_each = on; }
   void setCamera(CameraPreset preset) { view_.camera = preset; }
-  // The view from scanner unit `index` (Scanners tab); false when there is no such unit.
-  bool setUnitCamera(size_t index);
+  // The view from a scanner unit, as the Unit button gives it: the unit that took the
+  // stored scan shown, else the Scanners tab's first; false when there is neither.
+  bool setUnitCamera();
+  // What the panels show, as JSON (state.cpp): the scan, the view's captions, the
+  // deviation from the design in mm, the section table, the browser and the messages.
+  nlohmann::json state() const;
   void stopLive() { live_.mode.stop(); }
   LiveStatus liveStatus() const { return live_.mode.status(); }
 
@@ -184,6 +191,8 @@ class App {
   void drawView(float x, float y, float w, float h);         // view_panel.cpp
   void forwardViewInput(float origin_x, float origin_y);
   void drawViewCaptions(float origin_x, float origin_y, float w, float h);
+  std::string viewTitle() const;                              // the scan shown, as the view's caption says
+  std::optional<CameraPlacement> unitPlacement() const;       // scanners_panel.cpp
   void drawPlots(float x, float y, float w, float h);        // plots_panel.cpp
   void drawRightPanel(float x, float y, float w, float h);   // app.cpp: the tabs below
   void drawSectionTable();                                    // sections_panel.cpp
@@ -215,6 +224,10 @@ class App {
   std::unique_ptr<VtkViewport> viewport_;
   bool initial_load_done_ = false;
 };
+
+// The deviation line of the 3D view and of the Sections tab (mm).
+std::string deviationCaption(const DistanceStats& d);
+std::string deviationSummary(const DistanceStats& d);
 
 // The colour of the k-th overlaid trim step.
 Rgb overlayColour(size_t k);

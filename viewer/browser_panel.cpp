@@ -30,12 +30,13 @@ void App::drawBrowser(float x, float y, float w, float h) {
       const float tree_h = std::max(80.0f, ImGui::GetContentRegionAvail().y - 250.0f);
       ImGui::BeginChild("tree", ImVec2(0, tree_h), true);
       for (const auto& c : browser_.tree.campaigns) {
-        if (!ImGui::TreeNodeEx(c.name.c_str(), ImGuiTreeNodeFlags_DefaultOpen)) continue;
+        // Long campaign, test and step names wrap in the panel rather than run out of it.
+        if (!wrappedTreeNode("c" + c.name, c.name, ImGuiTreeNodeFlags_DefaultOpen)) continue;
         for (const auto& t : c.tests) {
-          if (!ImGui::TreeNodeEx((t.label() + "##" + c.name).c_str(), ImGuiTreeNodeFlags_DefaultOpen)) continue;
+          if (!wrappedTreeNode("t" + c.name + t.name, t.label(), ImGuiTreeNodeFlags_DefaultOpen)) continue;
           for (const auto& s : t.steps) {
-            const std::string id = s.label() + "##" + c.name + t.name + s.sail + std::to_string(s.step);
-            const bool open = ImGui::TreeNodeEx(id.c_str(), ImGuiTreeNodeFlags_DefaultOpen);
+            const std::string id = "s" + c.name + t.name + s.sail + std::to_string(s.step);
+            const bool open = wrappedTreeNode(id, s.label(), ImGuiTreeNodeFlags_DefaultOpen);
             if (ImGui::IsItemHovered() && !s.controls.empty())
               ImGui::SetTooltip("controls: %s%s", s.controls.c_str(),
                                 s.drive_n ? ("\ndrive " + format("%.0f N", *s.drive_n)).c_str() : "");

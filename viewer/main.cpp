@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <stdexcept>
@@ -35,7 +36,18 @@ struct Options {
   std::vector<std::string> show;  // --show: what the 3D view draws
   int live = 0;        // --live N: live mode on an emulated deck unit until N sweeps are analysed
   std::string camera;  // --camera: a preset applied before frames are counted
+  std::string state;   // --state: the panels' content as JSON, written with the screenshot
 };
+
+void writeState(const App& app, const std::string& path) {
+  const std::string tmp = path + ".part";
+  {
+    std::ofstream out(tmp);
+    out << app.state().dump(2) << "\n";
+    if (!out.flush()) throw std::runtime_error("cannot write " + path);
+  }
+  std::filesystem::rename(tmp, path);
+}
 
 // --show design,surface,cluster,...: exactly these layers in the 3D view.
 ViewOptions shownLayers(ViewOptions o, const std::vector<std::string>& layers) {
@@ -248,7 +260,7 @@ int run(const Options& o) {
                                                                 {"bow", CameraPreset::Bow}};
         for (const auto& [name, preset] : presets)
           if (o.camera == name) app.setCamera(preset);
-        if (o.camera == "unit" && !app.setUnitCamera(0)) return 1;
+        if (o.camera == "unit" && !app.setUnitCamera()) return 1;
       }
       if (!report_started && app.settled()) {
         report_started = true;
@@ -263,7 +275,11 @@ int run(const Options& o) {
         saveScreenshot(o.screenshot, fb_w, fb_h);
         std::cout << "sailshape-viewer: wrote " << o.screenshot << " (" << fb_w << "×" << fb_h << ", " << counted
                   << " frames)\n";
+        if (!o.state.empty()) writeState(app, o.state);
         glfwSwapBuffers(window.handle);
+        // The screenshot shows the panels' message; the exit status tells a script (the one line on
+        // stderr was written when the open failed).
+        if (o.database && !app.databaseOpen()) return 1;
         if (timed_out) {
           std::cerr << "sailshape-viewer: the scan was still loading after 300 s; the screenshot shows the state then\n";
           return 1;
@@ -312,14 +328,18 @@ int main(int argc, char** argv) {
                  "with --screenshot: once loaded, view from this preset: 3/4, side, top, astern, bow, or unit (from "
                  "the first scanner unit, e.g. the one --live adds)")
       ->check(CLI::IsMember({"3/4", "side", "top", "astern", "bow", "unit"}));
+  cli.add_option("--state", o.state,
+                 "with --screenshot: also write what the panels show as JSON to this file (the scan shown and its "
+                 "captions, design-vs-flying statistics in mm, the section table, the browser's labels, messages)");
   cli.add_flag("--deviation", o.deviation, "start with the flying shape coloured by signed deviation from the design");
   try {
     cli.parse(argc, argv);
     if (!o.screenshot.empty() && o.frames == 0) throw CLI::ValidationError("--screenshot", "needs --frames N");
     if (o.screenshot.empty() && (o.frames || o.exercise_window || !o.report.empty() || !o.pick.empty() || o.live ||
-                                !o.camera.empty()))
+                                !o.camera.empty() || !o.state.empty()))
       throw CLI::ValidationError("--frames",
-                                 "--frames, --exercise-window, --report, --pick, --live and --camera need --screenshot");
+                                 "--frames, --exercise-window, --report, --pick, --live, --camera and --state need "
+                                 "--screenshot");
     shownLayers(ViewOptions{}, o.show);
     if (o.exercise_window && o.frames < 16) throw CLI::ValidationError("--exercise-window", "needs --frames >= 16");
   } catch (const CLI::ParseError& e) {

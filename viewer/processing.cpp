@@ -167,7 +167,7 @@ int64_t saveStageResult(Database& db, int64_t scan_id, const StageResult& result
                               {params.transform.translation_m.x(), params.transform.translation_m.y(),
                                params.transform.translation_m.z()}}};
   doc["parameters"] = p;
-  return addAnalysis(db, scan_id, doc);
+  return addAnalysis(db, scan_id, doc, "0.1.0", &result.analysis->mesh);
 }
 
 }  // namespace sailshape::viewer

@@ -32,13 +32,18 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
         throw;
       } catch (const std::exception& e) {
         scene.analysis_error = e.what();
-        scene.warnings.push_back(std::string("flying surface: the pipeline failed on the stored cloud: ") + e.what());
+        scene.warnings.push_back(std::string(record.surface ? "sail cluster" : "flying surface") +
+                                 ": the pipeline failed on the stored cloud: " + e.what());
       }
     }
     record.cloud.reset();
   } else {
     scene.warnings.push_back("the scan has no stored cloud: sections only");
   }
+  // The surface stored with the analysis is the one its sections were cut from (and the
+  // report draws): it is shown, and the deviation measured on it, whatever a re-analysis finds.
+  if (record.surface && !record.surface->empty()) scene.surface = std::move(*record.surface);
+  record.surface.reset();
   scene.sections = record.sections;
   if (scene.sections.sections.empty() && scene.analysis) scene.sections = scene.analysis->sections;
   scene.record = std::move(record);

@@ -29,7 +29,7 @@ struct ScanScene {
   std::optional<SailAnalysis> analysis;     // the pipeline's run on the stored cloud
   std::string analysis_error;     // why that run failed (empty when it worked or did not run)
   std::vector<double> cluster_deviation_m;  // per analysis->sail_cloud point; empty without a design
-  Mesh surface;                   // flying surface (the analysis mesh); empty when unavailable
+  Mesh surface;                   // flying surface: stored with the analysis, else the re-analysis mesh; may be empty
   std::vector<double> surface_deviation_m;  // per surface vertex; empty without a design
   // The stored sections, or the fresh analysis's when the scan has none stored.
   SectionAnalysis sections;

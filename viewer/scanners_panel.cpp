@@ -45,12 +45,22 @@ bool App::addEmulatedDeckUnit() {
   }
 }
 
-bool App::setUnitCamera(size_t index) {
-  if (index >= scanner_.session.units().size()) {
-    log_.error("camera: no scanner unit " + std::to_string(index + 1));
+std::optional<CameraPlacement> App::unitPlacement() const {
+  // A stored scan shown is seen from the unit that took it; otherwise from the Scanners tab's first unit.
+  const std::optional<UnitConfig> scan_unit =
+      load_.scene && !live_.shown_sweep ? scanUnit(load_.scene->record) : std::nullopt;
+  if (scan_unit) return unitCamera(*scan_unit);
+  if (!scanner_.session.units().empty()) return unitCamera(scanner_.session.units().front().config);
+  return std::nullopt;
+}
+
+bool App::setUnitCamera() {
+  const std::optional<CameraPlacement> placement = unitPlacement();
+  if (!placement) {
+    log_.error("camera: no scanner unit: the scan shown stores none, and the Scanners tab has none");
     return false;
   }
-  view_.placement = unitCamera(scanner_.session.units()[index].config);
+  view_.placement = *placement;
   return true;
 }
 

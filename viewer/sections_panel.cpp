@@ -9,6 +9,12 @@
 
 namespace sailshape::viewer {
 
+std::string deviationSummary(const DistanceStats& d) {
+  return "mean " + signedFormat("%.0f", 1000 * d.mean_m) + "  rms " + format("%.0f", 1000 * d.rms_m) + "  p5 " +
+         signedFormat("%.0f", 1000 * d.p5_m) + "  p50 " + signedFormat("%.0f", 1000 * d.p50_m) + "  p95 " +
+         signedFormat("%.0f", 1000 * d.p95_m) + "  max |" + format("%.0f", 1000 * d.max_abs_m) + "| mm";
+}
+
 void App::drawSectionTable() {
   if (!load_.scene) {
     ImGui::TextColored(kMutedText, "No scan shown.");
@@ -17,9 +23,8 @@ void App::drawSectionTable() {
   const ScanScene& s = *load_.scene;
   if (s.deviation) {
     const DistanceStats& d = s.deviation.value();
-    ImGui::Text("Flying − design, signed (+ leeward), %zu points", d.count);
-    ImGui::TextColored(kMutedText, "mean %+.0f  rms %.0f  p5 %+.0f  p50 %+.0f  p95 %+.0f  max|%.0f| mm", 1000 * d.mean_m,
-                       1000 * d.rms_m, 1000 * d.p5_m, 1000 * d.p50_m, 1000 * d.p95_m, 1000 * d.max_abs_m);
+    wrappedText(ImGui::GetStyleColorVec4(ImGuiCol_Text), "Flying − design, signed (+ leeward), " + std::to_string(d.count) + " points");
+    wrappedText(kMutedText, deviationSummary(d));
   } else if (s.design.empty()) {
     ImGui::TextColored(kMutedText, "The sail has no design in the database: flying values only.");
   }
@@ -77,7 +82,7 @@ void App::drawSectionTable() {
   }
   if (!s.warnings.empty()) {
     ImGui::Spacing();
-    for (const auto& wmsg : s.warnings) ImGui::TextColored(kMutedText, "· %s", wmsg.c_str());
+    for (const auto& wmsg : s.warnings) wrappedText(kMutedText, "· " + wmsg);
   }
 }
 

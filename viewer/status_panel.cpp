@@ -27,7 +27,8 @@ void App::drawStatus(float x, float y, float w, float h) {
       }
     } else if (!log_.lines.empty()) {
       const std::string& last = log_.lines.back();
-      ImGui::TextColored(last.rfind("error:", 0) == 0 ? kErrorText : kMutedText, "%s", last.c_str());
+      // One line: the whole message is in the Messages tab and the tooltip.
+      elidedText(last.rfind("error:", 0) == 0 ? kErrorText : kMutedText, last, ImGui::GetContentRegionAvail().x);
     } else {
       ImGui::TextColored(kMutedText, "ready");
     }

@@ -31,12 +31,10 @@ void App::drawToolbar(float x, float y, float w, float h) {
       if (ImGui::Button(label)) view_.camera = preset;
     }
     ImGui::SameLine();
-    // A stored scan shown is seen from the unit that took it; otherwise from the Scanners tab's first unit.
-    const std::optional<UnitConfig> scan_unit =
-        load_.scene && !live_.shown_sweep ? scanUnit(load_.scene->record) : std::nullopt;
-    ImGui::BeginDisabled(!scan_unit && scanner_.session.units().empty());
-    if (ImGui::Button("Unit"))
-      view_.placement = unitCamera(scan_unit ? *scan_unit : scanner_.session.units().front().config);
+    const std::optional<CameraPlacement> unit_view = unitPlacement();
+    const bool scan_unit = load_.scene && !live_.shown_sweep && scanUnit(load_.scene->record);
+    ImGui::BeginDisabled(!unit_view);
+    if (ImGui::Button("Unit")) view_.placement = unit_view;
     ImGui::EndDisabled();
     if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
       ImGui::SetTooltip(scan_unit ? "from the unit that took this scan (its stored unit settings and registration), "

@@ -1,6 +1,7 @@
 // The 3D view: VTK's picture, the mouse forwarded to it, and the captions drawn over it.
 #include "viewer/app.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -8,9 +9,27 @@
 
 namespace sailshape::viewer {
 
+std::string App::viewTitle() const {
+  if (!load_.scene) return "";
+  const ScanRecord& r = load_.scene->record;
+  std::string title = r.campaign + " · " + (r.test.empty() ? "" : r.test + " · ") + "step " + std::to_string(r.step) +
+                      " · " + r.sail;
+  if (live_.shown_sweep) title = "LIVE sweep " + std::to_string(live_.shown_sweep) + " · " + title;
+  if (r.awa_deg) title += " · AWA " + format("%.0f°", *r.awa_deg);
+  return title;
+}
+
+std::string deviationCaption(const DistanceStats& d) {
+  return "deviation from design (+ to leeward): mean " + format("%+.0f", 1000 * d.mean_m) + " mm, rms " +
+         format("%.0f", 1000 * d.rms_m) + " mm, max |" + format("%.0f", 1000 * d.max_abs_m) + "| mm";
+}
+
 void App::drawView(float x, float y, float w, float h) {
   ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
-  if (beginPanel("3D view", x, y, w, h, ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse)) {
+  // The mouse hint rides in the title bar, where it never covers the sail (in live mode the
+  // unit's view puts the sail anywhere in the picture).
+  if (beginPanel("3D view      drag: rotate · right/wheel: zoom · middle: pan · click: pick###3D view", x, y, w, h,
+                 ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse)) {
     const ImVec2 avail = ImGui::GetContentRegionAvail();
     const int vw = static_cast<int>(avail.x), vh = static_cast<int>(avail.y);
     if (view_.rebuild) {
@@ -98,27 +117,20 @@ void App::drawViewCaptions(float origin_x, float origin_y, float w, float h) {
     dl->AddText(ImVec2(origin.x + 32, ty), IM_COL32(235, 235, 240, 255), text.c_str());
     ty += 18;
   };
+  // Captions wrap within the view rather than run out of it.
+  const float wrap = std::max(avail.x - 24, 40.0f);
   if (load_.scene) {
-    const ScanRecord& r = load_.scene->record;
-    std::string title = r.campaign + " · " + (r.test.empty() ? "" : r.test + " · ") + "step " +
-                        std::to_string(r.step) + " · " + r.sail;
-    if (live_.shown_sweep) title = "LIVE sweep " + std::to_string(live_.shown_sweep) + " · " + title;
-    if (r.awa_deg) title += " · AWA " + format("%.0f°", *r.awa_deg);
-    dl->AddText(ImVec2(origin.x + 12, ty), IM_COL32(255, 210, 90, 255), title.c_str());
-    ty += 22;
+    ty += wrappedCaption(dl, ImVec2(origin.x + 12, ty), IM_COL32(255, 210, 90, 255), viewTitle(), wrap) + 4;
     if (!load_.scene->design.empty()) legend(kDesignColour, "design");
     if (!load_.scene->surface.empty() || !load_.scene->raw_cloud.empty())
-      legend(kFlyingColour, r.scan_id ? "flying, scan " + std::to_string(r.scan_id) : std::string("flying, not stored"));
+      legend(kFlyingColour, load_.scene->record.scan_id ? "flying, scan " + std::to_string(load_.scene->record.scan_id)
+                                                        : std::string("flying, not stored"));
     for (const auto& ov : overlayList())
       legend(toU32(ov.colour), "step " + std::to_string(ov.scene->record.step) + ", scan " +
                                    std::to_string(ov.scene->record.scan_id));
-    if (load_.scene->deviation) {
-      const DistanceStats& d = *load_.scene->deviation;
-      const std::string line = "deviation from design (+ to leeward): mean " + format("%+.0f", 1000 * d.mean_m) + " mm, rms " +
-                               format("%.0f", 1000 * d.rms_m) + " mm, max |" + format("%.0f", 1000 * d.max_abs_m) + "| mm";
-      dl->AddText(ImVec2(origin.x + 12, ty + 4), IM_COL32(200, 205, 215, 255), line.c_str());
-      ty += 22;
-    }
+    if (load_.scene->deviation)
+      ty += wrappedCaption(dl, ImVec2(origin.x + 12, ty + 4), IM_COL32(200, 205, 215, 255),
+                           deviationCaption(*load_.scene->deviation), wrap) + 8;
   } else {
     const char* msg = !database_.db ? (database_.error.empty() ? "No database open" : database_.error.c_str())
                       : browser_.tree.scan_count == 0 ? "The database has no scans"
@@ -138,9 +150,6 @@ void App::drawViewCaptions(float origin_x, float origin_y, float w, float h) {
     dl->AddRectFilled(ImVec2(at.x - 6, at.y - 4), ImVec2(at.x + ts.x + 6, at.y + ts.y + 4), IM_COL32(0, 0, 0, 170), 4);
     dl->AddText(at, IM_COL32(255, 240, 120, 255), text.c_str());
   }
-  const char* hint = "drag: rotate · right/wheel: zoom · middle: pan · click: pick";
-  dl->AddText(ImVec2(origin.x + avail.x - ImGui::CalcTextSize(hint).x - 10, origin.y + avail.y - 20),
-              IM_COL32(150, 155, 165, 255), hint);
 }
 
 }  // namespace sailshape::viewer

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cfloat>
 #include <cstdio>
 
 namespace sailshape::viewer {
@@ -30,6 +31,46 @@ bool beginPanel(const char* name, float x, float y, float w, float h, ImGuiWindo
   ImGui::SetNextWindowPos(ImVec2(x, y));
   ImGui::SetNextWindowSize(ImVec2(std::max(w, 1.0f), std::max(h, 1.0f)));
   return ImGui::Begin(name, nullptr, kPanelFlags | extra);
+}
+
+bool wrappedTreeNode(const std::string& id, const std::string& label, ImGuiTreeNodeFlags flags) {
+  const bool open = ImGui::TreeNodeEx(("##" + id).c_str(), flags);
+  ImGui::SameLine(0, ImGui::GetStyle().ItemInnerSpacing.x);
+  ImGui::PushTextWrapPos(0.0f);
+  ImGui::TextUnformatted(label.c_str());
+  ImGui::PopTextWrapPos();
+  return open;
+}
+
+void wrappedText(const ImVec4& colour, const std::string& text) {
+  ImGui::PushStyleColor(ImGuiCol_Text, colour);
+  ImGui::PushTextWrapPos(0.0f);
+  ImGui::TextUnformatted(text.c_str());
+  ImGui::PopTextWrapPos();
+  ImGui::PopStyleColor();
+}
+
+void elidedText(const ImVec4& colour, const std::string& text, float width) {
+  if (ImGui::CalcTextSize(text.c_str()).x <= width) {
+    ImGui::TextColored(colour, "%s", text.c_str());
+    return;
+  }
+  const char* ellipsis = "…";
+  const float room = width - ImGui::CalcTextSize(ellipsis).x;
+  size_t keep = text.size();
+  while (keep > 0 && ImGui::CalcTextSize(text.c_str(), text.c_str() + keep).x > room) {
+    --keep;
+    while (keep > 0 && (static_cast<unsigned char>(text[keep]) & 0xC0) == 0x80) --keep;  // whole UTF-8 characters
+  }
+  ImGui::TextColored(colour, "%s%s", text.substr(0, keep).c_str(), ellipsis);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text.c_str());
+}
+
+float wrappedCaption(ImDrawList* dl, ImVec2 at, ImU32 colour, const std::string& text, float width) {
+  ImFont* font = ImGui::GetFont();
+  const float size = ImGui::GetFontSize();
+  dl->AddText(font, size, at, colour, text.c_str(), nullptr, width);
+  return font->CalcTextSizeA(size, FLT_MAX, width, text.c_str()).y;
 }
 
 void helpMarker(const char* text) {

@@ -30,6 +30,18 @@ std::string signedFormat(const char* fmt, double v);
 // resized or collapsed. Call ImGui::End() whatever it returns.
 bool beginPanel(const char* name, float x, float y, float w, float h, ImGuiWindowFlags extra = 0);
 
+// A tree node whose label wraps within the panel instead of running out of it:
+// the arrow, then the label as wrapped text beside it. `id` must be unique in the
+// tree. Returns whether it is open (then call ImGui::TreePop()).
+bool wrappedTreeNode(const std::string& id, const std::string& label, ImGuiTreeNodeFlags flags = 0);
+// `text` in `colour`, wrapped at the panel's right edge.
+void wrappedText(const ImVec4& colour, const std::string& text);
+// `text` cut to `width` pixels with "…" when longer (a one-line bar); the whole
+// text is the item's tooltip then.
+void elidedText(const ImVec4& colour, const std::string& text, float width);
+// `text` drawn into `dl` at `at`, wrapped at `width` pixels; returns its height.
+float wrappedCaption(ImDrawList* dl, ImVec2 at, ImU32 colour, const std::string& text, float width);
+
 // A "(?)" after the last item that shows `text` when hovered.
 void helpMarker(const char* text);
 // An integer field whose value is kept within [lo, hi].

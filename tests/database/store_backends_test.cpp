@@ -21,6 +21,21 @@ using test::scalar;
 
 class Store : public test::StoreTest {};
 
+// The surface an analysis of the Main reconstructed: two triangles over 2 m × 1 m.
+Mesh testSurface() {
+  Mesh m;
+  m.vertices = {{0, 0, 1}, {2, 0, 1}, {2, 0.1, 2}, {0, 0.1, 2}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
+}
+
+void expectSameMesh(const std::optional<Mesh>& got, const Mesh& want) {
+  ASSERT_TRUE(got.has_value());
+  ASSERT_EQ(got->vertices.size(), want.vertices.size());
+  ASSERT_EQ(got->triangles, want.triangles);
+  for (size_t i = 0; i < want.vertices.size(); ++i) EXPECT_EQ(got->vertices[i], want.vertices[i]) << i;
+}
+
 // The Queries fixture's data set (queries_test.cpp): Gen-A (genoa, boat Alpha,
 // campaign Lorient) test t1 steps 0..3 at AWA 80/90/95/100, drive
 // 100/150/130/120 N, side 50/60/40/80 N, sheet 0.1·step, camber at section k
@@ -65,7 +80,8 @@ void fill(Database& db) {
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0, 0.004);
   for (int i = 0; i < 2000; ++i) cloud.points.emplace_back(i * 1e-3, noise(rng), 1.0 + noise(rng));
-  importScan(db, m, &doc_m, &cloud);
+  const Mesh surface = testSurface();
+  importScan(db, m, &doc_m, &cloud, {}, &surface);
 }
 
 // Every query the CLI offers, as CSV, in one string.
@@ -111,11 +127,25 @@ TEST_P(Store, MigratesFromEveryOlderVersionKeepingData) {
       migrateSchema(raw, from);
       EXPECT_EQ(raw.userVersion(), from);
       if (from >= 1) raw.exec("INSERT INTO campaigns(name) VALUES ('kept')");
+      if (from >= 1) {
+        raw.exec("INSERT INTO scans(point_count) VALUES (0)");
+        raw.exec("INSERT INTO analyses(scan_id, software_version) VALUES (1, 'old')");
+      }
     }
     Database db = openSailDatabase(location);
     EXPECT_EQ(db.userVersion(), kSchemaVersion) << "from " << from;
     EXPECT_EQ(scalar(db, "SELECT count(*) FROM design_comparisons"), 0) << "from " << from;
     if (from >= 1) EXPECT_EQ(scalar(db, "SELECT count(*) FROM campaigns WHERE name = 'kept'"), 1) << "from " << from;
+    // Version 4: analyses keep their reconstructed surface; one stored before has none.
+    if (from >= 1) {
+      EXPECT_EQ(scalar(db, "SELECT count(*) FROM analyses WHERE surface_mesh IS NULL"), 1) << "from " << from;
+      EXPECT_FALSE(analysisSurface(db, 1).has_value()) << "from " << from;
+    }
+    const Mesh surface = testSurface();
+    const nlohmann::json doc = analysisDoc(9.0);
+    ImportMetadata m;
+    const ImportResult r = importScan(db, m, &doc, nullptr, {}, &surface);
+    expectSameMesh(analysisSurface(db, r.analysis_id), surface);
     EXPECT_TRUE(db.integrityCheck().empty()) << "from " << from;
   }
 }
@@ -167,6 +197,27 @@ TEST_P(Store, ImportStoresScanAnalysisAndCloudAndReadsThemBack) {
   EXPECT_EQ(r.campaign, "Tunnel");
   EXPECT_EQ(r.analysis_params["sensor_sigma_m"].get<double>(), 0.004);
   EXPECT_TRUE(db.integrityCheck().empty());
+}
+
+// The surface the analysis reconstructed is stored with it, by an import and by a later
+// analysis of the same scan; an analysis stored from its JSON alone has none.
+TEST_P(Store, AnAnalysisKeepsTheSurfaceItReconstructed) {
+  Database db = openSailDatabase(location_);
+  const Mesh surface = testSurface();
+  const nlohmann::json doc = analysisDoc(9.0);
+  ImportMetadata m;
+  const ImportResult with = importScan(db, m, &doc, nullptr, {}, &surface);
+  expectSameMesh(analysisSurface(db, with.analysis_id), surface);
+  const ImportResult without = importScan(db, m, &doc);
+  EXPECT_FALSE(analysisSurface(db, without.analysis_id).has_value());
+  Mesh moved = surface;
+  for (Vec3& v : moved.vertices) v.z() += 0.5;
+  const int64_t again = addAnalysis(db, without.scan_id, doc, "0.1.0", &moved);
+  expectSameMesh(analysisSurface(db, again), moved);
+  EXPECT_FALSE(analysisSurface(db, addAnalysis(db, without.scan_id, doc)).has_value());
+  // An empty mesh is no surface.
+  const Mesh empty;
+  EXPECT_FALSE(analysisSurface(db, importScan(db, m, &doc, nullptr, {}, &empty).analysis_id).has_value());
 }
 
 TEST_P(Store, AFailedImportStoresNothing) {
@@ -254,6 +305,7 @@ TEST_P(Store, CopiesIntoAnEmptyStoreOfEitherBackendAndBack) {
   EXPECT_EQ(allAnswers(back), expected);
   EXPECT_EQ(cloudBlob(back), blob);
   EXPECT_EQ(loadScanRecord(back, 6).cloud->size(), 2000u);
+  expectSameMesh(analysisSurface(back, scalar(back, "SELECT max(id) FROM analyses")), testSurface());
   // New rows after a copy take ids after the copied ones.
   ImportMetadata m;
   m.sail = "Gen-A";

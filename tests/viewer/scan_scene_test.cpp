@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/design/sail_generator.hpp"
 #include "database/catalog.hpp"
+#include "database/import.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/scan_scene.hpp"
 #include "viewer/worker.hpp"
@@ -59,6 +61,32 @@ TEST(ScanScene, WithoutDesignOrCloudItSaysWhatIsMissing) {
   ASSERT_EQ(scene.sections.sections.size(), 1u);
   ASSERT_EQ(scene.warnings.size(), 1u);
   EXPECT_NE(scene.warnings[0].find("no stored cloud"), std::string::npos);
+}
+
+// The surface stored with the analysis is the one its sections were cut from: the scene shows
+// it and measures the deviation on it, even where a re-analysis of the cloud fails.
+TEST(ScanScene, TheStoredSurfaceIsShownAndMeasured) {
+  test::TempDir dir;
+  Database db = openSailDatabase(dir.file("s.sqlite"));
+  const SailDesign design = exampleDesign(SailType::Main);
+  const Mesh design_mesh = generateSailMesh(design);
+  const Mesh flying = generateSailMesh(test::trimmed(2.0, 3.0));
+  const auto doc = nlohmann::json{{"sections", nlohmann::json::array({{{"fraction", 0.5}, {"camber_pct", 13.0}}})}};
+  Cloud two_points;
+  two_points.points = {Vec3(0, 0, 0), Vec3(1, 0, 0)};  // a re-analysis fails on it
+  ImportMetadata meta;
+  const ImportResult r = importScan(db, meta, &doc, &two_points, {}, &flying);
+  const ScanScene scene = buildScanScene(loadScanRecord(db, r.scan_id), design_mesh);
+  ASSERT_EQ(scene.surface.vertices.size(), flying.vertices.size());
+  EXPECT_EQ(scene.surface.triangles, flying.triangles);
+  ASSERT_EQ(scene.surface_deviation_m.size(), flying.vertices.size());
+  ASSERT_TRUE(scene.deviation.has_value());
+  // +2 % camber and +3° twist put the whole surface to leeward of the design; the stored
+  // vertices are exact, so no point lies to windward beyond the distance's own error.
+  EXPECT_GT(scene.deviation->mean_m, 0.0);
+  EXPECT_GT(scene.deviation->p5_m, -0.001);
+  ASSERT_FALSE(scene.warnings.empty());
+  EXPECT_NE(scene.warnings[0].find("sail cluster: the pipeline failed"), std::string::npos) << scene.warnings[0];
 }
 
 TEST(ScanScene, APipelineFailureBecomesAWarning) {

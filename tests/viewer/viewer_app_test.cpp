@@ -4,6 +4,8 @@
 #include <stb_image.h>
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -17,92 +19,12 @@
 #include "tests/database/pg_cluster.hpp"
 #include "viewer/catalog_tree.hpp"
 #include "viewer_fixture.hpp"
+#include "viewer_run.hpp"
 
 namespace sailshape::viewer {
 namespace {
 
-constexpr int kWidth = 1600, kHeight = 1000;
-
-struct ViewerRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-ViewerRun runViewer(const test::TempDir& dir, const std::string& args) {
-  std::string launcher;
-  if (std::system("command -v xvfb-run >/dev/null 2>&1") == 0)
-    launcher = "xvfb-run -a -s '-screen 0 1920x1200x24' ";  // a private server even when DISPLAY is set
-  else if (!std::getenv("DISPLAY"))
-    ADD_FAILURE() << "neither xvfb-run nor a DISPLAY: install xvfb (scripts/setup)";
-  const std::string out = dir.file("stdout.txt"), err = dir.file("stderr.txt");
-  const std::string cmd = launcher + quote(SAILSHAPE_VIEWER_BIN) + " " + args + " --width " + std::to_string(kWidth) +
-                          " --height " + std::to_string(kHeight) + " </dev/null >" + quote(out) + " 2>" + quote(err);
-  const int status = std::system(cmd.c_str());
-  ViewerRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
-
-struct Image {
-  int width = 0, height = 0;
-  std::unique_ptr<unsigned char, void (*)(void*)> rgb{nullptr, stbi_image_free};
-  const unsigned char* at(int x, int y) const { return rgb.get() + 3 * (static_cast<size_t>(y) * width + x); }
-};
-
-Image load(const std::string& path) {
-  Image img;
-  int channels = 0;
-  img.rgb.reset(stbi_load(path.c_str(), &img.width, &img.height, &channels, 3));
-  return img;
-}
-
-struct Rect {
-  int x0, y0, x1, y1;
-};
-
-// The fixed layout of a 1600 × 1000 window (viewer/app.cpp): toolbar 40 px, status
-// bar 28 px, browser 300 px on the left, analysis panel 440 px on the right, the
-// 3D view over 64 % of the middle height and the plots below; a few pixels in
-// from every edge and below the panel title bars.
-const Rect kView{310, 70, 1150, 626};
-const Rect kPlots{310, 690, 1150, 960};
-const Rect kBrowser{6, 62, 294, 600};
-const Rect kAnalysis{1166, 62, 1594, 900};
-// The scalar bar: 90–98 % of the view's width, 12–88 % of its height.
-const Rect kScalarBar{1080, 140, 1140, 560};
-
-using Pixel = std::function<bool(int r, int g, int b)>;
-
-size_t count(const Image& img, const Rect& r, const Pixel& is) {
-  size_t n = 0;
-  for (int y = r.y0; y < r.y1; ++y)
-    for (int x = r.x0; x < r.x1; ++x) {
-      const unsigned char* p = img.at(x, y);
-      if (is(p[0], p[1], p[2])) ++n;
-    }
-  return n;
-}
-
-double area(const Rect& r) { return double(r.x1 - r.x0) * (r.y1 - r.y0); }
-
-// The design's blue (64, 140, 255) and the flying shape's red (220, 34, 26), shaded.
-const Pixel kBlue = [](int r, int g, int b) { return b > 170 && b > r + 80 && b > g + 40; };
-const Pixel kRed = [](int r, int g, int b) { return r > 110 && r > 2 * g && r > 2 * b; };
-const Pixel kText = [](int r, int g, int b) { return r > 170 && g > 170 && b > 170; };
-const Pixel kErrorText = [](int r, int g, int b) { return r > 200 && g > 80 && g < 160 && b < 160 && r > g + 60; };
+using namespace run_test;
 
 class ViewerApp : public ::testing::Test {
  protected:
@@ -214,6 +136,12 @@ void expectLiveModeShowsEachAnalysedSweepAndStoresIt(const test::TempDir& dir, c
   EXPECT_GT(count(img, kPlots, kBlue), 150u);
   EXPECT_GT(count(img, kAnalysis, kText), 1000u);
   EXPECT_GT(count(img, kBrowser, kText), 200u) << "the stored sweeps are listed";
+  // The unit's view puts the sail anywhere in the picture: the mouse hint is in the title bar, not over it.
+  const Pixel hint_grey = [](int r, int g, int b) {
+    return r > 120 && r < 200 && g > 120 && g < 200 && b > 120 && b < 210 && std::abs(r - b) < 25;
+  };
+  EXPECT_EQ(count(img, Rect{700, 590, 1150, 626}, hint_grey), 0u);
+  EXPECT_GT(count(img, Rect{380, 40, 760, 60}, kText), 200u);
 
   Database stored = openSailDatabase(db);
   const CatalogTree tree = loadCatalogTree(stored);
@@ -258,8 +186,10 @@ TEST_F(ViewerApp, AMissingFileIsReportedAndNotCreated) {
   const std::string missing = dir_->file("no-such.sqlite");
   const std::string png = dir_->file("missing.png");
   const ViewerRun r = runViewer(*dir_, quote(missing) + " --screenshot " + quote(png) + " --frames 3");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // A script learns it from the exit status and one line; the screenshot shows what a person would see.
+  EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("database file not found: " + missing), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(std::filesystem::exists(missing));
   const Image img = load(png);
   ASSERT_TRUE(img.rgb);
@@ -287,6 +217,10 @@ TEST_F(ViewerApp, RefusesBadOptions) {
   const ViewerRun live_alone = runViewer(*dir_, "--live 2");
   EXPECT_NE(live_alone.exit_code, 0);
   EXPECT_NE(live_alone.err.find("--screenshot"), std::string::npos) << live_alone.err;
+  const ViewerRun state_alone = runViewer(*dir_, quote(dir_->file("sails.sqlite")) + " --state " + quote(dir_->file("x.json")));
+  EXPECT_NE(state_alone.exit_code, 0);
+  EXPECT_NE(state_alone.err.find("--screenshot"), std::string::npos) << state_alone.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_->file("x.json")));
   const ViewerRun report_alone = runViewer(*dir_, "--report " + quote(dir_->file("x.pdf")));
   EXPECT_NE(report_alone.exit_code, 0);
   EXPECT_NE(report_alone.err.find("--screenshot"), std::string::npos) << report_alone.err;
