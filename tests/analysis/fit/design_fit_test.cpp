@@ -13,6 +13,7 @@
 #include <array>
 
 #include "analysis/design/design_compare.hpp"
+#include "analysis/pipeline/pipeline.hpp"
 #include "tests/support/fit_case.hpp"
 #include "tests/support/fixtures.hpp"
 
@@ -104,6 +105,77 @@ TEST(DesignFit, DeeperAndMoreTwistedThroughGaps) {
   o.seed = testSeed();
   const FitCase c = makeFitCase(o);
   expectKnownAnswers(c, o, c.scan.points);
+}
+
+// The same in a scene (mast, boom and deck at the same density): the pipeline's segmentation
+// hands the fit the sail's own samples, and the fit meets the same known answers.
+TEST(DesignFit, DeeperAndMoreTwistedInASceneAfterSegmentation) {
+  FitCaseOptions o;
+  o.seed = testSeed();
+  o.scene = true;
+  const FitCase c = makeFitCase(o);
+  const Cloud sail = sailSamples(c.scan);
+  size_t foreign = 0, sail_points = 0;
+  for (char s : c.is_sail) sail_points += s ? 1 : 0;
+  {
+    // Samples the segmentation kept that are not the sail: within a few σ of a spar's surface.
+    const DesignDistance truth(generateSailMesh(c.flying, 320, 160));
+    for (const Vec3& p : sail.points) foreign += std::abs(truth.signedDistance(p)) > 5 * kSigma ? 1 : 0;
+  }
+  std::printf("segmentation kept %zu of %zu sail points, %zu more than 5σ off the sail\n", sail.size(), sail_points,
+              foreign);
+  EXPECT_GT(static_cast<double>(sail.size()), 0.9 * static_cast<double>(sail_points));
+  expectKnownAnswers(c, o, sail.points);
+}
+
+TEST(DesignFit, RefusesBadInputNamingIt) {
+  FitCaseOptions o;
+  o.points = 5000;
+  const FitCase c = makeFitCase(o);
+  expectInvalidInput([&] { fitDesign(c.design_mesh, {}); }, {"no points"});
+  expectInvalidInput([&] { fitDesign(Mesh{}, c.scan.points); }, {"no triangles"});
+  std::vector<Vec3> nan = c.scan.points;
+  nan[17].y() = std::nan("");
+  expectInvalidInput([&] { fitDesign(c.design_mesh, nan); }, {"point 17", "non-finite"});
+  // The same sail 30 m away: not in the design's frame.
+  std::vector<Vec3> far = c.scan.points;
+  for (Vec3& p : far) p += Vec3(30, 0, 0);
+  expectInvalidInput([&] { fitDesign(c.design_mesh, far); }, {"from the design", "not in the boat frame"});
+  Mesh broken = c.design_mesh;
+  broken.triangles[3][1] = 999999;
+  expectInvalidInput([&] { fitDesign(broken, c.scan.points); }, {"vertex index 999999"});
+  DesignFitParams p;
+  p.bending_length_m = 0;
+  expectInvalidInput([&] { fitDesign(c.design_mesh, c.scan.points, p); }, {"bending_length_m"});
+  p = {};
+  p.outer_iterations = 0;
+  expectInvalidInput([&] { fitDesign(c.design_mesh, c.scan.points, p); }, {"outer_iterations"});
+}
+
+// A design that stands a few cm off in the boat frame (a tack fitting 5 cm aft and lower, a
+// degree more rake) is brought onto the scan by the rigid stage first; the fitted surface then
+// passes through the samples as if the design had been placed right.
+TEST(DesignFit, RigidStageCorrectsAMisplacedDesign) {
+  FitCaseOptions o;
+  o.seed = testSeed();
+  FitCase c = makeFitCase(o);
+  c.flying = c.design;  // the same shape: only the placement differs
+  ScanSimulation sim;
+  sim.points = 40'000;
+  sim.noise_sigma_m = kSigma;
+  sim.seed = o.seed;
+  const Cloud scan = sampleSail(c.flying, sim);
+  Mesh moved = c.design_mesh;
+  const Eigen::Isometry3d t = Eigen::Translation3d(-0.05, 0.0, -0.03) * Eigen::AngleAxisd(0.0175, Vec3::UnitY());
+  for (Vec3& v : moved.vertices) v = t * v;
+  const DesignFit fit = fitDesign(moved, scan.points);
+  for (const auto& w : fit.warnings) std::printf("warning: %s\n", w.c_str());
+  // The rigid stage undid the move: its transform composes with t to the identity within
+  // the noise's reach over a 10 m sail (σ/√n on the pose, well under a millimetre).
+  const Eigen::Matrix4d undo = fit.rigid * t.matrix();
+  EXPECT_LT((undo.block<3, 1>(0, 3)).norm(), 0.005);
+  EXPECT_LT(Eigen::AngleAxisd(Eigen::Matrix3d(undo.block<3, 3>(0, 0))).angle(), 0.001);
+  EXPECT_LT(fit.rms_m, 1.2 * kSigma);
 }
 
 }  // namespace
