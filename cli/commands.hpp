@@ -11,6 +11,7 @@ void addAnalyzeCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addDesignCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
+void addFitCommand(CLI::App& app);
 void addDbCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
