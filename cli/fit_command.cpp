@@ -119,7 +119,7 @@ void addFitCommand(CLI::App& app) {
   auto opt = std::make_shared<FitOptions>();
   CLI::App* cmd = app.add_subcommand(
       "fit",
-      "Deform the design onto a flying scan: the whole flying sail, where the scanner could not see it too\n\n"
+      "Deform the design onto a flying scan: the whole sail, where the scanner missed it too\n\n"
       "Deform the design mesh onto a flying scan, keeping the design's vertices in their order and its "
       "triangles: each design point mapped to where it flies. A scene cloud is segmented to the sail first, as "
       "analyze does. The design is first aligned rigidly to the samples (point-to-plane ICP from where it stands; "

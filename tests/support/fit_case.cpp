@@ -1,6 +1,9 @@
 #include "tests/support/fit_case.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include "analysis/design/design_compare.hpp"
 
 namespace sailshape {
 
@@ -52,6 +55,27 @@ FitCase makeFitCase(const FitCaseOptions& o) {
     c.is_sail.push_back(sail[i]);
   }
   return c;
+}
+
+std::array<RegionError, 3> regionErrors(const std::vector<Vec3>& vertices, const FitCase& c, const FitCaseOptions& o,
+                                        const std::vector<char>* supported, const std::vector<double>* sigma) {
+  const SailSurface truth(c.flying);
+  // 320 × 160 cells: the truth mesh's own chord error (cell² · curvature / 8) is hundredths of a mm.
+  const DesignDistance truth_mesh(generateSailMesh(c.flying, 320, 160));
+  std::array<RegionError, 3> e{};
+  for (size_t v = 0; v < vertices.size(); ++v) {
+    const DesignDistance::Closest foot = truth_mesh.closest(vertices[v]);
+    const FitRegion region = fitRegion(truth, foot.point, o);
+    if (region == FitRegion::Scanned && supported && !(*supported)[v]) continue;
+    RegionError& r = e[static_cast<size_t>(region)];
+    const double d = std::abs(foot.distance_m);
+    ++r.count;
+    r.rms_m += d * d;
+    r.max_m = std::max(r.max_m, d);
+    if (sigma && d <= 3 * (*sigma)[v]) ++r.within_3_sigma;
+  }
+  for (RegionError& r : e) r.rms_m = r.count ? std::sqrt(r.rms_m / static_cast<double>(r.count)) : 0.0;
+  return e;
 }
 
 }  // namespace sailshape

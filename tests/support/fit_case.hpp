@@ -2,6 +2,7 @@
 // A design and the same sail flying deeper and more twisted, scanned with gaps (issue 37's
 // known answer): an interior hole over 20 % of the height and nothing above 88 % of it, as
 // the sun and the range leave real scans. For tests/analysis/fit, the CLI's tests and the bench.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -39,5 +40,19 @@ FitCase makeFitCase(const FitCaseOptions& options);
 
 // Where a point of (or near) the flying sail lies against the scan's gaps.
 FitRegion fitRegion(const SailSurface& flying, const Vec3& p, const FitCaseOptions& options);
+
+// RMS and largest distance to the true flying surface of the vertices in each region
+// (indexed by FitRegion: the region of the vertex's foot on the true surface). With
+// `supported`, a vertex counts as scanned only where it is supported (one that stands beyond
+// the flying sail's edge was not scanned, wherever its foot lies); with `sigma`, how many lie
+// within 3σ.
+struct RegionError {
+  size_t count = 0;
+  double rms_m = 0, max_m = 0;
+  size_t within_3_sigma = 0;
+};
+std::array<RegionError, 3> regionErrors(const std::vector<Vec3>& vertices, const FitCase& c, const FitCaseOptions& o,
+                                        const std::vector<char>* supported = nullptr,
+                                        const std::vector<double>* sigma = nullptr);
 
 }  // namespace sailshape
