@@ -367,7 +367,7 @@ void BM_Ours_DesignFit(benchmark::State& state) {
   state.counters["above_rms_mm"] = 1000 * e[2].rms_m;
   state.counters["design_above_rms_mm"] = 1000 * design[2].rms_m;
   state.counters["coverage"] = fit.coverage;
-  finish(state, c.size());
+  finish(state, c.scan.size());
 }
 
 // ---- registration (issue 5): the two-unit tunnel scene at about 200,000 points per unit ----

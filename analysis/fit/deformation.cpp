@@ -273,10 +273,17 @@ std::vector<Eigen::Matrix3d> vertexRotations(const Mesh& design, const Topology&
 
 }  // namespace
 
+struct StepSolver {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  bool analysed = false;
+};
+void StepSolverDeleter::operator()(StepSolver* s) const { delete s; }
+StepSolverPtr makeStepSolver() { return StepSolverPtr(new StepSolver); }
+
 std::vector<Vec3> deformStep(const Regulariser& reg, const Mesh& design, const Topology& top,
                              const std::vector<Vec3>& current, const std::vector<Vec3>& samples,
                              const std::vector<Foot>& feet, const std::vector<char>& use, double sample_area_m2,
-                             double stiffness) {
+                             double stiffness, StepSolver& step_solver) {
   const size_t n = design.vertices.size();
   const std::vector<Eigen::Matrix3d> rot = vertexRotations(design, top, current);
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n), 3);
@@ -321,7 +328,12 @@ std::vector<Vec3> deformStep(const Regulariser& reg, const Mesh& design, const T
   Eigen::SparseMatrix<double> m(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
   m.setFromTriplets(trip.begin(), trip.end());
   m += stiffness * reg.matrix;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(m);
+  auto& solver = step_solver.ldlt;
+  if (!step_solver.analysed) {
+    solver.analyzePattern(m);
+    step_solver.analysed = true;
+  }
+  solver.factorize(m);
   if (solver.info() != Eigen::Success) throw AnalysisError("[fitDesign] the deformation's system is singular");
   const Eigen::MatrixXd sol = solver.solve(rhs);
   std::vector<Vec3> x(n);

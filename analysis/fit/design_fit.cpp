@@ -93,9 +93,9 @@ void checkNearDesign(const Mesh& design, const std::vector<Vec3>& sub, const Des
 // identity; returns design → samples' frame.
 RigidTransform alignRigidly(const Mesh& design, const std::vector<Vec3>& sub, const DesignFitParams& p,
                             const Progress& progress, DesignFit& out) {
-  Cloud reference = sampleMesh(design, 20'000, 1);
+  Cloud reference = sampleMesh(design, 10'000, 1);
   Cloud moving;
-  moving.points = strided(sub, 5000);
+  moving.points = strided(sub, 3000);
   IcpParams ip;
   ip.max_correspondence_m = p.rigid_max_correspondence_m;
   ip.min_robust_scale_m = p.sensor_sigma_m;
@@ -255,7 +255,7 @@ DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const 
   DesignFit out;
   out.samples = samples.size();
   const std::vector<Vec3> sub = strided(samples, 20'000);
-  checkNearDesign(design, sub, p);
+  checkNearDesign(design, strided(sub, 2000), p);
   progress("rigid alignment", 0.0);
   Mesh aligned = design;
   if (p.rigid) {
@@ -284,12 +284,13 @@ DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const 
   const double ramp = std::max(1.0, iterations / 2.0 - 1.0);
   std::vector<Foot> feet;
   std::vector<char> use;
+  const StepSolverPtr solver = makeStepSolver();
   for (int it = 0; it < iterations; ++it) {
     feet = findFeet(aligned, x, top, samples);
     const double gate = std::max(3.0 * p.sensor_sigma_m, 3.0 * robustScale(feet, nullptr));
     use = gateSamples(samples, feet, gate, p.sensor_sigma_m);
     const double stiffness = std::pow(p.initial_stiffness, std::max(0.0, 1.0 - it / ramp));
-    x = deformStep(*reg, aligned, top, x, samples, feet, use, sample_area, stiffness);
+    x = deformStep(*reg, aligned, top, x, samples, feet, use, sample_area, stiffness, *solver);
     progress("fitting the design", static_cast<double>(it + 1) / iterations);
   }
   out.iterations = iterations;

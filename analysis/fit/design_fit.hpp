@@ -30,7 +30,7 @@ struct DesignFitParams {
   // follow the data; membrane_length_m does the same for in-plane stretch. Both only weigh the
   // regulariser against the data: where there are no samples the regulariser alone decides.
   double bending_length_m = 0.1;
-  double membrane_length_m = 0.05;
+  double membrane_length_m = 0.04;
   // The first iterations, far from the samples, are this many times stiffer (the stiffness
   // falls geometrically to 1 over the first half of the iterations), so wrong early
   // correspondences cannot fold the mesh.

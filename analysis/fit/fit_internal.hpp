@@ -44,6 +44,16 @@ using RegulariserPtr = std::unique_ptr<Regulariser, RegulariserDeleter>;
 RegulariserPtr buildRegulariser(const Mesh& design, const Topology& top, double membrane_length_m,
                                 double bending_length_m);
 
+// The factorisation the global steps share: the system's sparsity is the regulariser's every
+// iteration (the data couple only vertices of one triangle, which the membrane couples too),
+// so its ordering is computed once.
+struct StepSolver;
+struct StepSolverDeleter {
+  void operator()(StepSolver* s) const;
+};
+using StepSolverPtr = std::unique_ptr<StepSolver, StepSolverDeleter>;
+StepSolverPtr makeStepSolver();
+
 // One global step: the vertices minimising data + stiffness · regulariser, with the
 // rotations read from `current` (the local step) and the samples held to their feet's
 // tangent planes. `use[s]` says whether sample s counts; `sample_area_m2` is the area
@@ -51,7 +61,7 @@ RegulariserPtr buildRegulariser(const Mesh& design, const Topology& top, double 
 std::vector<Vec3> deformStep(const Regulariser& reg, const Mesh& design, const Topology& top,
                              const std::vector<Vec3>& current, const std::vector<Vec3>& samples,
                              const std::vector<Foot>& feet, const std::vector<char>& use, double sample_area_m2,
-                             double stiffness);
+                             double stiffness, StepSolver& solver);
 
 // Area of each vertex's share of its triangles (a third of each), m².
 std::vector<double> vertexAreas(const Mesh& mesh);

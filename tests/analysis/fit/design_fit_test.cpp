@@ -66,8 +66,22 @@ void expectKnownAnswers(const FitCase& c, const FitCaseOptions& o, const std::ve
   std::sort(sig_scanned.begin(), sig_scanned.end());
   EXPECT_LT(sig_scanned[sig_scanned.size() / 2], kSigma);
   EXPECT_GT(static_cast<double>(after[2].within_3_sigma), 0.8 * static_cast<double>(after[2].count));
-  // The flying sail is the same cloth: no edge stretched beyond the plausible limit.
-  EXPECT_LT(fit.strain_supported.p95_pct, 5.0);
+  // Strain: the generator maps design (f, u) to flying (f, u), which stretches the edges of
+  // this deeper, more twisted sail by 3.3 % at the 95th percentile; the fit need not find that
+  // same map where the surface gives no tangential hold, so the two agree to 1.5 points.
+  const Mesh flying_mesh = generateSailMesh(c.flying, o.rows, o.columns);
+  std::vector<double> true_strain;
+  for (const auto& t : c.design_mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = t[k], b = t[(k + 1) % 3];
+      true_strain.push_back(100 * ((flying_mesh.vertices[a] - flying_mesh.vertices[b]).norm() /
+                                       (c.design_mesh.vertices[a] - c.design_mesh.vertices[b]).norm() -
+                                   1));
+    }
+  std::sort(true_strain.begin(), true_strain.end());
+  const double true_p95 = true_strain[true_strain.size() * 19 / 20];
+  std::printf("strain p95: true %.2f %%, fitted %.2f %%\n", true_p95, fit.strain.p95_pct);
+  EXPECT_NEAR(fit.strain.p95_pct, true_p95, 1.5);
 }
 
 TEST(DesignFit, DeeperAndMoreTwistedThroughGaps) {
