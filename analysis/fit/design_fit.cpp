@@ -46,7 +46,7 @@ void checkInput(const Mesh& design, const std::vector<Vec3>& samples, const Desi
   positive(p.max_median_distance_of_extent, "max_median_distance_of_extent");
   if (!(p.initial_stiffness >= 1)) throw InvalidInput("[fitDesign] initial_stiffness must be >= 1");
   if (!(p.support_radius_m >= 0)) throw InvalidInput("[fitDesign] support_radius_m must be >= 0 (0: automatic)");
-  if (!(p.curvature_prior_per_m >= 0)) throw InvalidInput("[fitDesign] curvature_prior_per_m must be >= 0");
+  if (!(p.camber_change_prior >= 0)) throw InvalidInput("[fitDesign] camber_change_prior must be >= 0");
   if (p.outer_iterations < 1 || p.outer_iterations > 100)
     throw InvalidInput("[fitDesign] outer_iterations must be in [1, 100] (got " + std::to_string(p.outer_iterations) +
                        ")");
@@ -319,8 +319,9 @@ DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const 
   out.coverage = total_area > 0 ? covered / total_area : 0.0;
   out.displacement_m.resize(x.size());
   for (size_t v = 0; v < x.size(); ++v) out.displacement_m[v] = x[v] - design.vertices[v];
+  const double mean_chord = total_area / std::max(1e-9, diagonal(design.vertices));
   out.sigma_m = vertexSigmas(out.fitted, feet, use, out.support_distance_m, std::max(out.noise_m, 1e-6),
-                             p.curvature_prior_per_m);
+                             8.0 * p.camber_change_prior / mean_chord);
   strainAndWarnings(design, top, p, out);
   if (out.samples_used < samples.size() / 2)
     out.warnings.push_back("only " + std::to_string(out.samples_used) + " of " + std::to_string(samples.size()) +

@@ -38,9 +38,12 @@ struct DesignFitParams {
   // A vertex within this distance of a sample is supported (0: three times the samples'
   // median spacing).
   double support_radius_m = 0;
-  // How far the flying sail's curvature may differ from the design's where nothing was seen,
-  // 1/m: σ grows as ½·Δκ·d² with the distance d from the samples (see fitDesign).
-  double curvature_prior_per_m = 0.05;
+  // How far the flying sail's camber may differ from the design's where nothing was seen, as a
+  // fraction of the chord (0.03: 3 % of chord, a trim step's change). A parabolic section of
+  // depth c·chord bends at 8c/chord, so the curvature may differ by Δκ = 8·0.03/chord, the
+  // mean chord being the design's area over its height; σ grows as ½·Δκ·d² with the distance
+  // d from the samples (see fitDesign).
+  double camber_change_prior = 0.03;
   // Stretch beyond this (per-edge length change, %) is warned about: see fitDesign.
   double max_plausible_strain_pct = 5.0;
   // The scan lies "nowhere near" the design when the median distance of its samples to the
