@@ -285,12 +285,18 @@ DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const 
   std::vector<Foot> feet;
   std::vector<char> use;
   const StepSolverPtr solver = makeStepSolver();
+  // The stiff first iterations only bring the surface near the samples, smoothly: a quarter of
+  // the samples (still several per vertex on a scan denser than the design) does that as well.
+  const std::vector<Vec3> coarse = strided(samples, std::max<size_t>(samples.size() / 4, 1));
+  const double coarse_area = sample_area * static_cast<double>(samples.size()) / static_cast<double>(coarse.size());
   for (int it = 0; it < iterations; ++it) {
-    feet = findFeet(aligned, x, top, samples);
-    const double gate = std::max(3.0 * p.sensor_sigma_m, 3.0 * robustScale(feet, nullptr));
-    use = gateSamples(samples, feet, gate, p.sensor_sigma_m);
     const double stiffness = std::pow(p.initial_stiffness, std::max(0.0, 1.0 - it / ramp));
-    x = deformStep(*reg, aligned, top, x, samples, feet, use, sample_area, stiffness, *solver);
+    const bool stiff = stiffness > 2 && coarse.size() >= aligned.vertices.size();
+    const std::vector<Vec3>& pts = stiff ? coarse : samples;
+    feet = findFeet(aligned, x, top, pts);
+    const double gate = std::max(3.0 * p.sensor_sigma_m, 3.0 * robustScale(feet, nullptr));
+    use = gateSamples(pts, feet, gate, p.sensor_sigma_m);
+    x = deformStep(*reg, aligned, top, x, pts, feet, use, stiff ? coarse_area : sample_area, stiffness, *solver);
     progress("fitting the design", static_cast<double>(it + 1) / iterations);
   }
   out.iterations = iterations;
