@@ -139,14 +139,7 @@ void addFitCommand(CLI::App& app) {
   cmd->add_option("--json", opt->json_out,
                   "Write coverage, RMS, strain statistics, warnings and the per-vertex displacement, support "
                   "distance and σ as JSON to this file");
-  cmd->add_option("--unit", opt->unit, "Design file unit: auto (mm when the largest extent exceeds 100), m, mm or cm")
-      ->check(CLI::IsMember({"auto", "m", "mm", "cm"}))
-      ->capture_default_str();
-  cmd->add_option("--axes", opt->axes,
-                  "Design file frame: auto (sailcut for DXF and Y-up meshes, else boat), boat or sailcut (X tack to "
-                  "clew, Y up, Z depth)")
-      ->check(CLI::IsMember({"auto", "boat", "sailcut"}))
-      ->capture_default_str();
+  addDesignFrameOptions(cmd, opt->unit, opt->axes);
   cmd->add_option("--noise-mm", opt->noise_mm, "The scanner's range noise σ in mm (SPEC: 4 mm; up to 3.5× that in "
                                                "direct sunlight)")
       ->check(CLI::Range(0.1, 100.0))

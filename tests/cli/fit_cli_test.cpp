@@ -15,6 +15,7 @@
 #include "analysis/io/mesh_io.hpp"
 #include "tests/cli/run_sailshape.hpp"
 #include "tests/support/fit_case.hpp"
+#include "tests/support/fixtures.hpp"
 
 namespace sailshape {
 namespace {
@@ -51,16 +52,9 @@ class FitCli : public ::testing::Test {
   fs::path dir_;
 };
 
-uint64_t testSeed() {
-  const char* fixed = std::getenv("SAILSHAPE_TEST_SEED");
-  const uint64_t seed = fixed ? std::strtoull(fixed, nullptr, 10) : std::random_device{}();
-  std::printf("seed %llu (SAILSHAPE_TEST_SEED replays it)\n", static_cast<unsigned long long>(seed));
-  return seed;
-}
-
 TEST_F(FitCli, FitsTheDesignThroughTheScanAndAcrossItsGaps) {
   FitCaseOptions o;
-  o.seed = testSeed();
+  o.seed = freshTestSeed();
   o.scene = true;
   const FitCase c = makeFitCase(o);
   writeMesh((dir_ / "design.obj").string(), c.design_mesh);

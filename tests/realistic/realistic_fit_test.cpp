@@ -21,13 +21,6 @@
 namespace sailshape::realistic {
 namespace {
 
-uint64_t freshSeed() {
-  uint64_t seed = std::random_device{}() | (static_cast<uint64_t>(std::random_device{}()) << 32);
-  if (const char* s = std::getenv("SAILSHAPE_REALISTIC_SEED")) seed = std::strtoull(s, nullptr, 10);
-  std::printf("SAILSHAPE_REALISTIC_SEED=%llu\n", static_cast<unsigned long long>(seed));
-  return seed;
-}
-
 TEST(RealisticFit, OneUnitScanOfTheSailFlyingDeeperAndMoreTwisted) {
   Config config = drawConfig(freshSeed(), SailKind::SquareTopMain, UnitPlace::DeckLeeward);
   std::printf("%s\n", config.summary().c_str());

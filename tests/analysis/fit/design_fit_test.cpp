@@ -20,13 +20,6 @@
 namespace sailshape {
 namespace {
 
-uint64_t testSeed() {
-  const char* fixed = std::getenv("SAILSHAPE_TEST_SEED");
-  const uint64_t seed = fixed ? std::strtoull(fixed, nullptr, 10) : std::random_device{}();
-  std::printf("seed %llu (SAILSHAPE_TEST_SEED replays it)\n", static_cast<unsigned long long>(seed));
-  return seed;
-}
-
 void print(const char* what, const std::array<RegionError, 3>& e) {
   std::printf("%s: scanned %zu rms %.1f max %.1f mm; hole %zu rms %.1f max %.1f mm; above %zu rms %.1f max %.1f mm\n",
               what, e[0].count, 1e3 * e[0].rms_m, 1e3 * e[0].max_m, e[1].count, 1e3 * e[1].rms_m, 1e3 * e[1].max_m,
@@ -86,7 +79,7 @@ void expectKnownAnswers(const FitCase& c, const FitCaseOptions& o, const std::ve
 
 TEST(DesignFit, DeeperAndMoreTwistedThroughGaps) {
   FitCaseOptions o;
-  o.seed = testSeed();
+  o.seed = freshTestSeed();
   const FitCase c = makeFitCase(o);
   expectKnownAnswers(c, o, c.scan.points);
 }
@@ -95,7 +88,7 @@ TEST(DesignFit, DeeperAndMoreTwistedThroughGaps) {
 // hands the fit the sail's own samples, and the fit meets the same known answers.
 TEST(DesignFit, DeeperAndMoreTwistedInASceneAfterSegmentation) {
   FitCaseOptions o;
-  o.seed = testSeed();
+  o.seed = freshTestSeed();
   o.scene = true;
   const FitCase c = makeFitCase(o);
   const Cloud sail = sailSamples(c.scan);
@@ -141,7 +134,7 @@ TEST(DesignFit, RefusesBadInputNamingIt) {
 // passes through the samples as if the design had been placed right.
 TEST(DesignFit, RigidStageCorrectsAMisplacedDesign) {
   FitCaseOptions o;
-  o.seed = testSeed();
+  o.seed = freshTestSeed();
   FitCase c = makeFitCase(o);
   c.flying = c.design;  // the same shape: only the placement differs
   ScanSimulation sim;
