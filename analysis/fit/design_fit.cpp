@@ -103,6 +103,10 @@ RigidTransform alignRigidly(const Mesh& design, const std::vector<Vec3>& sub, co
   ip.max_curvature = 0.05;
   ip.max_normal_angle_deg = 45;
   ip.max_iterations = 30;
+  // A step under a tenth of a millimetre and 0.005° (0.9 mm over 10 m) is the pairs' noise
+  // moving the pose, not a better pose: the ICP has converged.
+  ip.min_step_translation_m = 1e-4;
+  ip.min_step_rotation_deg = 0.005;
   const IcpResult icp = refineIcp(reference, moving, RigidTransform::Identity(), ip, progress);
   out.rigid_rms_m = icp.rms_m;
   for (const std::string& w : icp.warnings) out.warnings.push_back("rigid alignment: " + w);
