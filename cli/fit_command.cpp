@@ -47,9 +47,7 @@ nlohmann::json fitJson(const FitOptions& o, const DesignImport& design, const De
   doc["flying"] = {{"file", o.flying}, {"points", flying_points}, {"sail_points", sail_points},
                    {"segmented", !o.no_segment}};
   doc["fitted"] = o.out;
-  nlohmann::json rigid = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) rigid.push_back({f.rigid(r, 0), f.rigid(r, 1), f.rigid(r, 2), f.rigid(r, 3)});
-  doc["rigid"] = {{"design_to_boat", rigid}, {"rms_m", f.rigid_rms_m}};
+  doc["rigid"] = {{"design_to_boat", matrixJson(f.rigid)}, {"rms_m", f.rigid_rms_m}};
   doc["coverage"] = f.coverage;
   doc["support_radius_m"] = f.support_radius_m;
   doc["rms_m"] = f.rms_m;

@@ -106,6 +106,15 @@ TEST_F(FitCli, FitsTheDesignThroughTheScanAndAcrossItsGaps) {
     for (int k = 0; k < 3; ++k)
       EXPECT_NEAR(v["displacement_m"][i][k].get<double>(), fitted.vertices[i][k] - c.design_mesh.vertices[i][k], 1e-6);
   EXPECT_EQ(doc["edges"]["strain_pct"].size(), doc["strain"]["edges"].get<size_t>());
+  // The rigid stage would slide this changed shape along itself by metres: the design stays where
+  // it stands (the identity) and a warning says why.
+  const nlohmann::json& rigid = doc["rigid"]["design_to_boat"];
+  ASSERT_EQ(rigid.size(), 4u);
+  for (int r = 0; r < 4; ++r)
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(rigid[r][k].get<double>(), r == k ? 1.0 : 0.0);
+  bool kept = false;
+  for (const auto& w : doc["warnings"]) kept = kept || w.get<std::string>().find("kept where it stands") != std::string::npos;
+  EXPECT_TRUE(kept) << doc["warnings"].dump();
   EXPECT_LT(doc["strain_supported"]["p95_pct"].get<double>(), 5.0);
 }
 
