@@ -11,6 +11,7 @@ void addAnalyzeCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addDesignCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
+void addFitCommand(CLI::App& app);
 void addDbCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
@@ -19,6 +20,9 @@ void addRegisterCommand(CLI::App& app);
 void addEmulateCommand(CLI::App& app);
 void addScanCommand(CLI::App& app);
 void addScannerCommand(CLI::App& app);
+
+// --unit and --axes of a command that reads a design file (DesignImportOptions' two fields).
+void addDesignFrameOptions(CLI::App* cmd, std::string& unit, std::string& axes);
 
 // The global --verbose flag; add it before the subcommands, which inherit it.
 void addVerboseFlag(CLI::App& app);

@@ -41,6 +41,10 @@ const std::vector<CommandExamples>& examples() {
       {"compare",
        {"sailshape compare --design main-design.obj --flying main.ply --no-segment --json compare.json",
         "sailshape compare --design main-design.obj --flying main.ply --no-segment --distances deviation.ply"}},
+      {"fit",
+       {"sailshape fit --design main-design.obj --flying main.ply --no-segment --out main-fitted.ply --json fit.json",
+        "sailshape fit --design main-design.obj --flying assets/sample-main-scene.ply --out main-fitted.obj "
+        "--iterations 12"}},
       {"demo", {"sailshape demo", "sailshape demo --dir demo-quick --steps 2 --scan-lines 300 --quiet"}},
       {"db", {"sailshape db init trials.db", "sailshape db query trials.db --sections --csv"}},
       {"db init", {"sailshape db init trials.db"}},

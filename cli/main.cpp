@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   sailshape::cli::addSimulateCommand(app);
   sailshape::cli::addDesignCommand(app);
   sailshape::cli::addCompareCommand(app);
+  sailshape::cli::addFitCommand(app);
   sailshape::cli::addDemoCommand(app);
   sailshape::cli::addDbCommand(app);
   sailshape::cli::addReplayCommand(app);

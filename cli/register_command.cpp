@@ -30,13 +30,6 @@ struct RegisterOptions {
 
 nlohmann::json vec(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
 
-nlohmann::json matrixJson(const RigidTransform& t) {
-  nlohmann::json m = nlohmann::json::array();
-  const Eigen::Matrix4d a = t.matrix();
-  for (int r = 0; r < 4; ++r) m.push_back({a(r, 0), a(r, 1), a(r, 2), a(r, 3)});
-  return m;
-}
-
 nlohmann::json statsJson(const NeighbourDistanceStats& s) {
   return {{"count", s.count},   {"mean_m", s.mean_m}, {"median_m", s.median_m}, {"p90_m", s.p90_m},
           {"max_m", s.max_m},   {"rms_m", s.rms_m},   {"bin_m", s.bin_m},       {"histogram", s.histogram}};
@@ -44,7 +37,7 @@ nlohmann::json statsJson(const NeighbourDistanceStats& s) {
 
 void describe(nlohmann::json& doc, const RigidTransform& t) {
   const Eigen::AngleAxisd aa(t.linear());
-  doc["matrix"] = matrixJson(t);
+  doc["matrix"] = matrixJson(t.matrix());
   doc["rotation_deg"] = aa.angle() * kDegPerRad;
   doc["rotation_axis"] = vec(aa.axis());
   doc["translation_m"] = vec(t.translation());
@@ -116,7 +109,7 @@ void run(const RegisterOptions& o) {
     doc["ambiguous"] = r.ambiguous;
     doc["accepted"] = r.accepted;
     doc["icp_iterations"] = r.icp_iterations;
-    doc["coarse_matrix"] = matrixJson(r.coarse);
+    doc["coarse_matrix"] = matrixJson(r.coarse.matrix());
     if (r.method == "planes") {
       nlohmann::json pl = {{"reference", r.reference_planes},
                            {"moving", r.moving_planes},

@@ -484,6 +484,16 @@ void refuseImplausibleResults(const SailAnalysis& a) {
 
 }  // namespace
 
+Cloud sailSamples(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
+  checkAnalysisParams(input, p);
+  SailAnalysis a;
+  Cloud cloud = input;
+  if (looksForMixedPixels(cloud, p)) cloud = selectPoints(cloud, removeMixedPixels(cloud, mixedPixelParams(p)).kept);
+  if (p.segment) segmentSail(cloud, p, progress, a);
+  removeOutliers(cloud, {}, p, progress, a);
+  return cloud;
+}
+
 SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Progress& progress,
                          SailAnalysis* surface_only) {
   checkAnalysisParams(input, p);

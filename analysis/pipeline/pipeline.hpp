@@ -108,6 +108,12 @@ Cloud withoutMixedPixels(const Cloud& scan, const AnalysisParams& p);
 // ascending, as sweeps write them. Returns a warning per corner widened.
 std::vector<std::string> widenCornersBesideLostLines(SailOutline& outline, const Cloud& scan);
 
+// The sail's own samples in a scene cloud, as analyzeSail finds them before it smooths:
+// mixed pixels out, the sail's region segmented from spars, deck and walls (unless
+// p.segment is false), outliers removed. For the design fit, which needs the samples
+// themselves. Throws as analyzeSail does for the input and AnalysisError when no sail is found.
+Cloud sailSamples(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {});
+
 // Throws InvalidInput for an empty cloud or bad parameters, AnalysisError when
 // a stage cannot produce its result (no sail found, no boundary, ...). When the
 // outline or the sections refuse (a patch of a sail, a scan that never reached a

@@ -96,8 +96,8 @@ void collectHelps(const fs::path& dir, const std::string& path, std::vector<std:
 TEST_F(Cli, EveryCommandsHelpEndsWithExamplesOfItself) {
   std::vector<std::pair<std::string, std::string>> helps;
   collectHelps(dir_, "", helps);
-  // sailshape, its 12 commands, design's 2, db's 9 and scanner's 1.
-  ASSERT_EQ(helps.size(), 25u);
+  // sailshape, its 13 commands, design's 2, db's 9 and scanner's 1.
+  ASSERT_EQ(helps.size(), 26u);
   for (const auto& [path, help] : helps) {
     const size_t examples = help.find("\nExamples:\n");
     ASSERT_NE(examples, std::string::npos) << "`sailshape " << path << " --help` has no examples:\n" << help;
@@ -138,7 +138,7 @@ TEST_F(Cli, ExamplesRunAsWritten) {
   fs::create_directory_symlink(fs::path(SAILSHAPE_ASSETS), dir_ / "assets");
   const std::string bin_dir = fs::path(SAILSHAPE_BIN).parent_path().string();
   int ran = 0;
-  for (const char* command : {"analyze", "simulate", "design", "design new", "design show", "compare", "db", "db init",
+  for (const char* command : {"analyze", "simulate", "design", "design new", "design show", "compare", "fit", "db", "db init",
                               "db import", "db list", "db show", "db query", "db export", "db check", "db backup", "db copy"}) {
     const Outcome help = sailshape(std::string(command) + " --help");
     for (const std::string& example : examplesOf(help.out)) {
@@ -161,7 +161,7 @@ TEST_F(Cli, CommandListsHaveOneShortLinePerCommand) {
   const Outcome top = sailshape("--help");
   ASSERT_EQ(top.exit_code, 0) << top.err;
   for (const std::string& line : lines(top.out)) EXPECT_LE(line.size(), 120u) << line;
-  EXPECT_EQ(subcommandsListed(top.out).size(), 12u) << top.out;
+  EXPECT_EQ(subcommandsListed(top.out).size(), 13u) << top.out;
 
   // The details stay in the command's own help: analyze's tells of mixed pixels, its line in the list does not.
   const Outcome analyze = sailshape("analyze --help");

@@ -18,14 +18,6 @@
 namespace sailshape::realistic {
 namespace {
 
-// Seeds drawn fresh each run, printed; SAILSHAPE_REALISTIC_SEED replays one.
-uint64_t freshSeed() {
-  uint64_t seed = std::random_device{}() | (static_cast<uint64_t>(std::random_device{}()) << 32);
-  if (const char* s = std::getenv("SAILSHAPE_REALISTIC_SEED")) seed = std::strtoull(s, nullptr, 10);
-  std::printf("SAILSHAPE_REALISTIC_SEED=%llu\n", static_cast<unsigned long long>(seed));
-  return seed;
-}
-
 // A unit 1 m above the floor of an empty scene, its β = 0 plane facing +X, sweeping β over ±4° and
 // α over 84°..96° (±6° about the horizontal).
 Config wallConfig(ScannerModel model) {

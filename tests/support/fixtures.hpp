@@ -4,6 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -17,6 +21,14 @@
 namespace sailshape {
 
 inline constexpr double kSigma = 0.004;  // sensor random error σ, SPEC §3
+
+// A seed drawn fresh each run and printed; SAILSHAPE_TEST_SEED replays one.
+inline uint64_t freshTestSeed() {
+  const char* fixed = std::getenv("SAILSHAPE_TEST_SEED");
+  const uint64_t seed = fixed ? std::strtoull(fixed, nullptr, 10) : std::random_device{}();
+  std::printf("seed %llu (SAILSHAPE_TEST_SEED replays it)\n", static_cast<unsigned long long>(seed));
+  return seed;
+}
 
 // Runs `f`, which must throw E whose message contains every part.
 template <class E, class F>

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 
 #include "analysis/core/errors.hpp"
@@ -505,6 +506,13 @@ Truth truthOf(const SailDesign& design) {
   }
   for (double f : kSectionFractions) t.sections.push_back(surface.section(f));
   return t;
+}
+
+uint64_t freshSeed() {
+  uint64_t seed = std::random_device{}() | (static_cast<uint64_t>(std::random_device{}()) << 32);
+  if (const char* s = std::getenv("SAILSHAPE_REALISTIC_SEED")) seed = std::strtoull(s, nullptr, 10);
+  std::printf("SAILSHAPE_REALISTIC_SEED=%llu\n", static_cast<unsigned long long>(seed));
+  return seed;
 }
 
 }  // namespace sailshape::realistic

@@ -102,6 +102,9 @@ struct Truth {
   double luff_m = 0, leech_m = 0, foot_m = 0, top_m = 0;
   std::vector<KnownSection> sections;  // at kSectionFractions
 };
+// A seed drawn fresh each run and printed; SAILSHAPE_REALISTIC_SEED replays one (for the tests).
+uint64_t freshSeed();
+
 // The analysis' default sections (SectionParams::count = 3).
 inline constexpr double kSectionFractions[] = {0.25, 0.5, 0.75};
 Truth truthOf(const SailDesign& design);
