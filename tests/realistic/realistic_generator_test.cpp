@@ -122,6 +122,25 @@ double distanceToSurface(const SailSurface& s, const Vec3& p) {
         const double d = (s.at(f, u) - p).norm();
         if (d < best) best = d, bf = f, bu = u;
       }
+  // Near the head the chordwise direction shrinks to nothing and the search above stalls along the
+  // narrow valley of (f, u); Gauss-Newton steps on the surface's tangent plane follow it.
+  for (int it = 0; it < 30; ++it) {
+    constexpr double e = 1e-6;
+    const Vec3 at = s.at(bf, bu);
+    Eigen::Matrix<double, 3, 2> J;
+    J.col(0) = (s.at(std::min(bf + e, 1.0), bu) - s.at(std::max(bf - e, 0.0), bu)) /
+               (std::min(bf + e, 1.0) - std::max(bf - e, 0.0));
+    J.col(1) = (s.at(bf, std::min(bu + e, 1.0)) - s.at(bf, std::max(bu - e, 0.0))) /
+               (std::min(bu + e, 1.0) - std::max(bu - e, 0.0));
+    const Eigen::Vector2d step = J.colPivHouseholderQr().solve(p - at);
+    bool moved = false;
+    for (double scale = 1; scale > 1e-4 && !moved; scale *= 0.5) {
+      const double f = std::clamp(bf + scale * step.x(), 0.0, 1.0), u = std::clamp(bu + scale * step.y(), 0.0, 1.0);
+      const double d = (s.at(f, u) - p).norm();
+      if (d < best) best = d, bf = f, bu = u, moved = true;
+    }
+    if (!moved) break;
+  }
   return best;
 }
 
