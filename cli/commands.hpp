@@ -19,6 +19,7 @@ void addRegisterCommand(CLI::App& app);
 void addEmulateCommand(CLI::App& app);
 void addScanCommand(CLI::App& app);
 void addScannerCommand(CLI::App& app);
+void addCropCommand(CLI::App& app);
 
 // The global --verbose flag; add it before the subcommands, which inherit it.
 void addVerboseFlag(CLI::App& app);

@@ -556,13 +556,8 @@ void storeStep(DemoRun& run, Database& db, int step, const std::string& tag, con
     us.row.scan_id = r.scan_id;
     run.result.scans.push_back(us.row);
     if (!us.analysis) continue;
-    json details = json::array();
-    for (const SectionDelta& d : us.comparison.sections)
-      details.push_back({{"fraction", d.fraction},
-                         {"design", sectionParametersToJson(d.design)},
-                         {"flying", sectionParametersToJson(d.flying)},
-                         {"delta", sectionParametersToJson(d.delta)}});
-    addDesignComparison(db, r.analysis_id, u.sail, us.comparison.stats, json{{"sections", details}});
+    addDesignComparison(db, r.analysis_id, u.sail, us.comparison.stats,
+                        json{{"sections", sectionDeltasToJson(us.comparison.sections)}});
     for (const SectionDelta& d : us.comparison.sections)
       run.result.sections.push_back({u.sail, step + 1, d.fraction, d.flying.camber_pct, d.flying.draft_pct,
                                      d.flying.twist_deg, d.delta.camber_pct, d.delta.draft_pct, d.delta.twist_deg});

@@ -96,7 +96,7 @@ TEST_P(Store, NewStoreIsAtTheCurrentVersionAndChecksClean) {
   Database db = openSailDatabase(location_);
   EXPECT_EQ(db.backend(), GetParam());
   EXPECT_EQ(db.userVersion(), kSchemaVersion);
-  EXPECT_EQ(db.tableCount(), 14);
+  EXPECT_EQ(db.tableCount(), 15);
   EXPECT_TRUE(db.integrityCheck().empty());
   // Opening again migrates nothing and keeps the version.
   Database again = openSailDatabase(location_);
