@@ -320,9 +320,18 @@ void runShow(const DbOptions& o) {
     const ScanRecord record = loadScanRecord(d, o.scan_id);
     if (!record.cloud)
       throw InvalidInput("db show: scan " + std::to_string(o.scan_id) + " has no stored cloud (only its analysis was imported)");
-    writeCloud(o.cloud_file, *record.cloud);
-    std::fprintf(stderr, "wrote the stored cloud of scan %lld (%zu points) to %s\n", static_cast<long long>(o.scan_id),
-                 record.cloud->size(), o.cloud_file.c_str());
+    // The sail's region when one is stored: what every analysis of the scan analyses.
+    // Mixed pixels go first, on the whole scan, as the surfaces behind tell them.
+    const Cloud out =
+        record.region ? cropToRegion(withoutMixedPixels(*record.cloud, AnalysisParams{}), record.region->box) : *record.cloud;
+    writeCloud(o.cloud_file, out);
+    if (record.region)
+      std::fprintf(stderr, "wrote the stored cloud of scan %lld in its sail's region %s m (%zu of %zu points) to %s\n",
+                   static_cast<long long>(o.scan_id), formatRegionBox(record.region->box).c_str(), out.size(),
+                   record.cloud->size(), o.cloud_file.c_str());
+    else
+      std::fprintf(stderr, "wrote the stored cloud of scan %lld (%zu points) to %s\n", static_cast<long long>(o.scan_id),
+                   record.cloud->size(), o.cloud_file.c_str());
   }
   const Table sections = findSections(d, f);
   // Sections the latest analysis was asked for but could not measure.
@@ -489,7 +498,9 @@ void addDbCommand(CLI::App& app) {
   show->add_flag("--json", o->json, "Print JSON");
   show->add_option("--cloud", o->cloud_file,
                    "Also write the scan's stored cloud to this file (.ply, .pcd, .xyz or .csv by its extension): its "
-                   "points with their intensity and scan angles, and the scanner's viewpoint, as stored; "
+                   "points with their intensity and scan angles, and the scanner's viewpoint, as stored; a scan "
+                   "stored with its sail's region (imported for a sail with a design, or by the demo) is written "
+                   "within that region, less its mixed pixels; "
                    "`sailshape analyze FILE --scanner MODEL` re-analyses it as the first analysis did");
   show->callback([o] { runShow(*o); });
 
