@@ -89,14 +89,7 @@ void addDbDesignCommand(CLI::App* db, const std::function<void(CLI::App*)>& add_
   add_db(add);
   sail(add);
   add->add_option("FILE", o->file, "Design file: .dxf (3DFACE, as Sailcut CAD exports it), .obj, .stl or .ply")->required();
-  add->add_option("--unit", o->unit, "File unit: auto (mm when the largest extent exceeds 100), m, mm or cm")
-      ->check(CLI::IsMember({"auto", "m", "mm", "cm"}))
-      ->capture_default_str();
-  add->add_option("--axes", o->axes,
-                  "File frame: auto (sailcut for DXF and Y-up meshes, else boat), boat (+X forward, +Y port, +Z up) "
-                  "or sailcut (X tack to clew, Y up, Z depth)")
-      ->check(CLI::IsMember({"auto", "boat", "sailcut"}))
-      ->capture_default_str();
+  addDesignFileOptions(add, o->unit, o->axes);
   add->callback([o, open] { runAdd(*o, open("design add")); });
 
   CLI::App* list = design->add_subcommand("list", "List a sail's design versions, the current one marked");

@@ -234,14 +234,7 @@ void addDesignCommand(CLI::App& app) {
       "Read a design (.dxf 3DFACE as Sailcut CAD exports it, .obj, .stl, .ply), bring it into the boat frame in "
       "metres, and report what was assumed, its corners, edge lengths, area and per-section parameters.");
   show->add_option("FILE", s->input, "Design file: .dxf, .obj, .stl or .ply")->required();
-  show->add_option("--unit", s->unit, "File unit: auto (mm when the largest extent exceeds 100), m, mm or cm")
-      ->check(CLI::IsMember({"auto", "m", "mm", "cm"}))
-      ->capture_default_str();
-  show->add_option("--axes", s->axes,
-                   "File frame: auto (sailcut for DXF and Y-up meshes, else boat), boat (+X forward, +Y port, +Z up) "
-                   "or sailcut (X tack to clew, Y up, Z depth)")
-      ->check(CLI::IsMember({"auto", "boat", "sailcut"}))
-      ->capture_default_str();
+  addDesignFileOptions(show, s->unit, s->axes);
   show->add_option("--sections", s->sections, "Number of sections N, at t = k/(N+1) of luff and leech")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();

@@ -29,6 +29,17 @@ DesignFile readDesignFile(const std::string& path, const std::string& unit, cons
   return out;
 }
 
+void addDesignFileOptions(CLI::App* cmd, std::string& unit, std::string& axes) {
+  cmd->add_option("--unit", unit, "File unit: auto (mm when the largest extent exceeds 100), m, mm or cm")
+      ->check(CLI::IsMember({"auto", "m", "mm", "cm"}))
+      ->capture_default_str();
+  cmd->add_option("--axes", axes,
+                  "File frame: auto (sailcut for DXF and Y-up meshes, else boat), boat (+X forward, +Y port, +Z up) "
+                  "or sailcut (X tack to clew, Y up, Z depth)")
+      ->check(CLI::IsMember({"auto", "boat", "sailcut"}))
+      ->capture_default_str();
+}
+
 DesignCheck checkAgainstDesign(const Mesh& design, const MeshSections& design_sections, const SailAnalysis& flying) {
   DesignCheck out;
   out.comparison = compareWithDesign(design, design_sections.sections, flying.sail_cloud.points, flying.sections);

@@ -4,6 +4,8 @@
 // be a sail, and compared with what the analysis found.
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "analysis/design/design_compare.hpp"
 #include "analysis/io/design_import.hpp"
 #include "analysis/pipeline/pipeline.hpp"
@@ -22,6 +24,9 @@ struct DesignFile {
 // InvalidInput naming the file when it is not a sail's surface.
 DesignFile readDesignFile(const std::string& path, const std::string& unit = "auto", const std::string& axes = "auto",
                           const SectionParams& sections = {});
+
+// --unit and --axes of a command that reads a design file (DesignImportOptions).
+void addDesignFileOptions(CLI::App* cmd, std::string& unit, std::string& axes);
 
 // `design show`'s table (or JSON to json_out) of a design: what the importer
 // applied, corners, edge lengths, area and sections; `input` names it.

@@ -90,6 +90,8 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
       const MeshSections ms = analyzeMeshSections(scene.design, OutlineParams{}, sp);
       scene.design_sections = ms.sections;
       scene.deltas = sectionDeltas(scene.design_sections, scene.sections);
+      if (scene.analysis && scene.deviation)
+        scene.design_mismatch = designMismatch(scene.design, ms, *scene.analysis, *scene.deviation);
     } catch (const Cancelled&) {
       throw;
     } catch (const std::exception& e) {

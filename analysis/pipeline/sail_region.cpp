@@ -16,6 +16,11 @@ Eigen::AlignedBox3d boundsOf(const Mesh& design) {
 }
 
 std::string mm(double m) { return std::to_string(static_cast<long>(std::lround(1000 * m))) + " mm"; }
+std::string metres(double m) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", m);
+  return buf;
+}
 std::string percent(double ratio) { return std::to_string(static_cast<long>(std::lround(100 * ratio))) + " %"; }
 
 }  // namespace
@@ -56,8 +61,8 @@ RegionBox parseRegionBox(const std::string& text) {
   RegionBox box;
   for (int a = 0; a < 3; ++a) {
     if (v[2 * a] > v[2 * a + 1])
-      throw InvalidInput(std::string("box: ") + "xyz"[a] + "min " + std::to_string(v[2 * a]) + " exceeds " + "xyz"[a] +
-                         "max " + std::to_string(v[2 * a + 1]));
+      throw InvalidInput(std::string("box: ") + "xyz"[a] + "min " + metres(v[2 * a]) + " exceeds " + "xyz"[a] + "max " +
+                         metres(v[2 * a + 1]) + " (XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX)");
     box.min()[a] = v[2 * a];
     box.max()[a] = v[2 * a + 1];
   }
