@@ -227,6 +227,9 @@ void runImport(DbOptions o) {
     }
     if (doc->contains("input") && (*doc)["input"].is_string() && m.raw_capture == o.file)
       m.raw_capture = (*doc)["input"].get<std::string>();
+    // `analyze --design` analysed its sail within a region: the stored cloud keeps it.
+    const nlohmann::json region = doc->value("design", nlohmann::json::object()).value("region_m", nlohmann::json());
+    if (region.is_string()) m.region = ScanRegion{parseRegionBox(region.get<std::string>()), 0};
   } else {
     if (!cloud_path.empty()) throw InvalidInput("db import: --cloud applies to an analysis JSON FILE only");
     cloud_path = o.file;

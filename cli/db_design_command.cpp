@@ -37,10 +37,11 @@ void runList(const DesignOptions& o, Database db) {
     return;
   }
   std::printf("%-8s %-21s %-8s %-5s %-8s %9s %s\n", "version", "added", "format", "unit", "axes", "triangles", "file");
+  auto text = [](const std::string& s) { return s.empty() ? "-" : s.c_str(); };  // not known: stored before versions
   for (const DesignVersion& v : versions)
     std::printf("%-8s %-21s %-8s %-5s %-8s %9zu %s\n", (std::to_string(v.version) + (v.current ? " *" : "")).c_str(),
-                v.added_at.c_str(), v.source.format.c_str(), v.source.unit.c_str(), v.source.axes.c_str(), v.triangles,
-                v.source.file.c_str());
+                v.added_at.c_str(), text(v.source.format), text(v.source.unit), text(v.source.axes), v.triangles,
+                text(v.source.file));
   std::printf("* current: reports, the viewer and imports use it\n");
 }
 

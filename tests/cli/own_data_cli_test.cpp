@@ -205,6 +205,15 @@ TEST_F(OwnData, ASailFarFromItsDesignIsAWarning) {
   ASSERT_EQ(own.exit_code, 0) << own.err;
   EXPECT_EQ(own.err.find("warning: the analysed surface"), std::string::npos) << own.err;
   EXPECT_EQ(nlohmann::json::parse(readText(dir_ / "own.json"))["design"]["mismatch"], "");
+  // Imported with its cloud, the analysis keeps the region it was cropped to.
+  ASSERT_EQ(sailshape("db init j.db").exit_code, 0);
+  ASSERT_EQ(sailshape("db import j.db own.json --cloud main.ply --sail M").exit_code, 0);
+  {
+    sailshape::Database db = sailshape::openSailDatabase((dir_ / "j.db").string());
+    const sailshape::ScanRecord record = sailshape::loadScanRecord(db, 1);
+    ASSERT_TRUE(record.region.has_value());
+    EXPECT_LT(record.region->box.min().z(), 1.0);  // the example main's tack stands at z = 1 m
+  }
   const Outcome other = sailshape("analyze main.ply --design big.obj -q --json other.json");
   ASSERT_EQ(other.exit_code, 0) << other.err;
   size_t warnings = 0;
