@@ -21,8 +21,9 @@ struct SailInfo {
   std::string boat;                                   // empty: left as stored; created when new
 };
 
-// Creates or updates the sail `info.name`; stores the design mesh and design
-// parameters when given. Returns the sail's id. One transaction.
+// Creates or updates the sail `info.name`; a design mesh that differs from the
+// sail's current one is stored as its next design version (addDesignVersion), with
+// the parameters when given. Returns the sail's id. One transaction.
 int64_t upsertSail(Database& db, const SailInfo& info, const Mesh* design_mesh = nullptr,
                    const nlohmann::json* design_params = nullptr);
 
