@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -14,9 +15,11 @@
 #include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/pipeline/params_io.hpp"
 #include "analysis/pipeline/pipeline.hpp"
+#include "analysis/pipeline/sail_region.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"
 #include "cli/progress_bar.hpp"
+#include "cli/sail_design.hpp"
 
 namespace sailshape::cli {
 namespace {
@@ -31,6 +34,9 @@ struct AnalyzeOptions {
   int corners = -1;
   std::string scanner;  // lms111 / lms511: its beam footprint for the edges
   std::vector<double> viewpoint;  // x, y, z of the scanner, m, for a cloud without one
+  std::string design;             // the sail's design: crop to its region, pick its cluster, check the match
+  double margin = 0;
+  bool margin_given = false;      // otherwise the design's plausible trim deviation
 };
 
 void printTable(const SailAnalysis& a) {
@@ -123,18 +129,42 @@ void run(const AnalyzeOptions& o) {
   CloudReadResult read = readCloud(o.input);
   for (const auto& w : read.warnings) std::fprintf(stderr, "warning: %s: %s\n", o.input.c_str(), w.c_str());
   if (!o.viewpoint.empty()) read.cloud.viewpoint = Vec3(o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]);
-  SailAnalysis a = analyzeSail(read.cloud, params, bar.progress());
+  std::optional<DesignFile> design;
+  std::optional<DesignCheck> check;
+  RegionBox region;
+  if (!o.design.empty()) {
+    design = readDesignFile(o.design, "auto", "auto", params.sections);
+    const Mesh& mesh = design->design.mesh;
+    region = designRegion(mesh, o.margin_given ? o.margin : plausibleTrimDeviationM(mesh));
+  } else if (o.margin_given) {
+    throw InvalidInput("analyze: --margin applies with --design only");
+  }
+  SailAnalysis a = design ? analyzeInRegion(read.cloud, region, design->design.mesh, params, bar.progress())
+                          : analyzeSail(read.cloud, params, bar.progress());
   bar.finish();
+  if (design) check = checkAgainstDesign(design->design.mesh, design->sections, a);
   if (!o.mesh_out.empty()) writeMesh(o.mesh_out, a.mesh);
   if (!o.cloud_out.empty()) writeCloud(o.cloud_out, a.sail_cloud);
   if (!o.json_out.empty()) {
     nlohmann::json doc = analysisToJson(a);
     doc["input"] = o.input;
     doc["parameters"] = paramsToJson(params);
+    if (design) {
+      const DistanceStats& st = check->comparison.stats;
+      doc["design"] = {{"file", o.design},
+                       {"region_m", formatRegionBox(region)},
+                       {"deviation_mean_m", st.mean_m},
+                       {"deviation_rms_m", st.rms_m},
+                       {"mismatch", check->mismatch}};
+    }
     writeJsonFile(o.json_out, doc);
     if (!o.quiet) std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());
   } else {
     printTable(a);
+    if (design)
+      std::printf("\nDesign %s: region %s m; deviation from it mean %+.1f mm, RMS %.1f mm\n", o.design.c_str(),
+                  formatRegionBox(region).c_str(), 1000 * check->comparison.stats.mean_m,
+                  1000 * check->comparison.stats.rms_m);
   }
 }
 
@@ -186,6 +216,14 @@ void addAnalyzeCommand(CLI::App& app) {
                   "never reached is refused rather than placed where the samples stop. Overrides the file's")
       ->expected(3)
       ->delimiter(',');
+  cmd->add_option("--design", opt->design,
+                  "The sail's design (.dxf, .obj, .stl, .ply, as `design show` reads): the scan (a whole tunnel or "
+                  "deck) is cropped to the design's box grown by --margin, segmentation takes the cluster that lies "
+                  "nearest the design, and a sail that flies farther from it than any plausible trim (RMS deviation "
+                  "beyond a fifth of the mean chord, area beyond ±20 %, an edge beyond ±10 %) is a warning");
+  auto* margin = cmd->add_option("--margin", opt->margin,
+                                 "With --design: metres added to every side of its box (default: a fifth of the "
+                                 "design's mean chord, as far as a plausible trim moves the sail)");
   cmd->add_flag("--no-segment", opt->no_segment, "The input is the sail alone: skip segmentation");
   auto* print = cmd->add_flag("--print-params", opt->print_params,
                               "Print every pipeline parameter with its value as JSON (a --params file) and exit");
@@ -194,7 +232,10 @@ void addAnalyzeCommand(CLI::App& app) {
                 "what it does; and exit")
       ->excludes(print);
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress output");
-  cmd->callback([opt] { run(*opt); });
+  cmd->callback([opt, margin] {
+    opt->margin_given = margin->count() > 0;
+    run(*opt);
+  });
 }
 
 }  // namespace sailshape::cli

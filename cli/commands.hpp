@@ -20,6 +20,7 @@ void addRegisterCommand(CLI::App& app);
 void addEmulateCommand(CLI::App& app);
 void addScanCommand(CLI::App& app);
 void addScannerCommand(CLI::App& app);
+void addCropCommand(CLI::App& app);
 
 // --unit and --axes of a command that reads a design file (DesignImportOptions' two fields).
 void addDesignFrameOptions(CLI::App* cmd, std::string& unit, std::string& axes);

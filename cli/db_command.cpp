@@ -10,8 +10,15 @@
 
 #include "analysis/core/errors.hpp"
 #include "analysis/io/cloud_io.hpp"
+#include "acquisition/sensor_model.hpp"
 #include "analysis/pipeline/analysis_json.hpp"
+#include "analysis/pipeline/params_io.hpp"
+#include "analysis/pipeline/sail_region.hpp"
 #include "cli/commands.hpp"
+#include "cli/db_design_command.hpp"
+#include "cli/progress_bar.hpp"
+#include "cli/sail_design.hpp"
+#include "database/catalog.hpp"
 #include "database/copy.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"
@@ -28,7 +35,7 @@ struct DbOptions {
   int busy_timeout_ms = 5000;
   // import
   ImportMetadata meta;
-  std::string cloud_file;
+  std::string cloud_file, scanner;
   double awa = NAN, aws = NAN, drive = NAN, side = NAN, heel = NAN;
   std::vector<std::string> sets, pressures;
   // queries
@@ -163,6 +170,39 @@ Table runQuery(Database& db, const DbOptions& o) {
   return o.sections ? findSections(db, f) : findScans(db, f);
 }
 
+// The analysis of `scan` for the sail m.sail's current design (version `version`):
+// sets m.region and m.design_comparison. Throws when the sail is not found in it
+// (nothing is stored then).
+nlohmann::json analyseForDesign(Database& db, const Cloud& scan, int version, const std::string& scanner,
+                                ImportMetadata& m) {
+  const Mesh design = designVersionMesh(db, m.sail, version);
+  AnalysisParams params;
+  if (!scanner.empty()) useScannerBeam(params.outline, parseScannerModel(scanner));
+  const MeshSections design_sections = designSections(design, params.sections);
+  m.region = ScanRegion{designRegion(design, plausibleTrimDeviationM(design)), version};
+  SailAnalysis a;
+  try {
+    ProgressBar bar(true);
+    a = analyzeInRegion(scan, m.region->box, design, params, bar.progress());
+    bar.finish();
+  } catch (const AnalysisError& e) {
+    throw AnalysisError("db import: sail \"" + m.sail + "\" (design version " + std::to_string(version) +
+                        ") not found in the scan: " + userMessage(e.what()) + "; nothing stored");
+  }
+  const DesignCheck check = checkAgainstDesign(design, design_sections, a);
+  m.design_comparison = ImportMetadata::Comparison{check.comparison.stats,
+                                                   {{"sections", sectionDeltasToJson(check.comparison.sections)},
+                                                    {"design_version", version},
+                                                    {"mismatch", check.mismatch}}};
+  nlohmann::json doc = analysisToJson(a);
+  doc["parameters"] = paramsToJson(params);
+  std::printf("analysed sail \"%s\" in its design's region (%s m): %zu points; deviation from design version %d: "
+              "mean %+.1f mm, RMS %.1f mm\n",
+              m.sail.c_str(), formatRegionBox(m.region->box).c_str(), a.sail_points, version,
+              1000 * check.comparison.stats.mean_m, 1000 * check.comparison.stats.rms_m);
+  return doc;
+}
+
 void runImport(DbOptions o) {
   Database db = openExisting(o, "import");
   ImportMetadata& m = o.meta;
@@ -187,6 +227,9 @@ void runImport(DbOptions o) {
     }
     if (doc->contains("input") && (*doc)["input"].is_string() && m.raw_capture == o.file)
       m.raw_capture = (*doc)["input"].get<std::string>();
+    // `analyze --design` analysed its sail within a region: the stored cloud keeps it.
+    const nlohmann::json region = doc->value("design", nlohmann::json::object()).value("region_m", nlohmann::json());
+    if (region.is_string()) m.region = ScanRegion{parseRegionBox(region.get<std::string>()), 0};
   } else {
     if (!cloud_path.empty()) throw InvalidInput("db import: --cloud applies to an analysis JSON FILE only");
     cloud_path = o.file;
@@ -196,6 +239,10 @@ void runImport(DbOptions o) {
     for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", cloud_path.c_str(), w.c_str());
     cloud = std::move(r.cloud);
   }
+  // A scan of a sail with a design is analysed as that sail: cropped to its region, the
+  // cluster matching the design; the region is stored so every re-analysis does the same.
+  const int design_version = doc ? 0 : currentDesignVersion(db, m.sail);
+  if (design_version > 0) doc = analyseForDesign(db, *cloud, design_version, o.scanner, m);
   const ImportResult r = importScan(db, m, doc ? &*doc : nullptr, cloud ? &*cloud : nullptr);
   // The step as the user numbered it within its test; the row id is what
   // `db query --best` lists as trim_step_id.
@@ -257,6 +304,10 @@ void addImportOptions(CLI::App* imp, DbOptions& o) {
   imp->add_option("--set", o.sets, "Control setting NAME=VALUE (tack_height, sheet, traveller, halyard, ...); repeatable")->allow_extra_args(false);
   imp->add_option("--pressure", o.pressures, "Pressure tap TAP=PASCAL; repeatable")->allow_extra_args(false);
   imp->add_option("--unit", o.meta.scanner_unit, "Scanner unit serial");
+  imp->add_option("--scanner", o.scanner,
+                  "A cloud FILE for a sail with a design is analysed as `sailshape analyze --design` does; this names "
+                  "the scanner model (lms111 or lms511) for its beam footprint, as `analyze --scanner`")
+      ->check(CLI::IsMember({"lms111", "lms511"}, CLI::ignore_case));
   imp->add_option("--scanned-at", o.meta.scanned_at, "Scan time, ISO 8601");
   imp->add_option("--raw-capture", o.meta.raw_capture, "Reference to the raw capture (default: the input file)");
 }
@@ -272,9 +323,18 @@ void runShow(const DbOptions& o) {
     const ScanRecord record = loadScanRecord(d, o.scan_id);
     if (!record.cloud)
       throw InvalidInput("db show: scan " + std::to_string(o.scan_id) + " has no stored cloud (only its analysis was imported)");
-    writeCloud(o.cloud_file, *record.cloud);
-    std::fprintf(stderr, "wrote the stored cloud of scan %lld (%zu points) to %s\n", static_cast<long long>(o.scan_id),
-                 record.cloud->size(), o.cloud_file.c_str());
+    // The sail's region when one is stored: what every analysis of the scan analyses.
+    // Mixed pixels go first, on the whole scan, as the surfaces behind tell them.
+    const Cloud out =
+        record.region ? cropToRegion(withoutMixedPixels(*record.cloud, AnalysisParams{}), record.region->box) : *record.cloud;
+    writeCloud(o.cloud_file, out);
+    if (record.region)
+      std::fprintf(stderr, "wrote the stored cloud of scan %lld in its sail's region %s m (%zu of %zu points) to %s\n",
+                   static_cast<long long>(o.scan_id), formatRegionBox(record.region->box).c_str(), out.size(),
+                   record.cloud->size(), o.cloud_file.c_str());
+    else
+      std::fprintf(stderr, "wrote the stored cloud of scan %lld (%zu points) to %s\n", static_cast<long long>(o.scan_id),
+                   record.cloud->size(), o.cloud_file.c_str());
   }
   const Table sections = findSections(d, f);
   // Sections the latest analysis was asked for but could not measure.
@@ -423,6 +483,8 @@ void addDbCommand(CLI::App& app) {
   addImportOptions(imp, *o);
   imp->callback([o] { runImport(*o); });
 
+  addDbDesignCommand(db, add_db, [o](const char* command) { return openExisting(*o, command); });
+
   CLI::App* list = db->add_subcommand("list", "List the scans (optionally filtered)");
   add_db(list);
   addFilterOptions(list, *o);
@@ -439,7 +501,9 @@ void addDbCommand(CLI::App& app) {
   show->add_flag("--json", o->json, "Print JSON");
   show->add_option("--cloud", o->cloud_file,
                    "Also write the scan's stored cloud to this file (.ply, .pcd, .xyz or .csv by its extension): its "
-                   "points with their intensity and scan angles, and the scanner's viewpoint, as stored; "
+                   "points with their intensity and scan angles, and the scanner's viewpoint, as stored; a scan "
+                   "stored with its sail's region (imported for a sail with a design, or by the demo) is written "
+                   "within that region, less its mixed pixels; "
                    "`sailshape analyze FILE --scanner MODEL` re-analyses it as the first analysis did");
   show->callback([o] { runShow(*o); });
 

@@ -27,6 +27,7 @@
 #include "analysis/io/cloud_io.hpp"
 #include "analysis/pipeline/analysis_json.hpp"
 #include "analysis/pipeline/pipeline.hpp"
+#include "analysis/pipeline/sail_region.hpp"
 #include "analysis/registration/boat_registration.hpp"
 #include "analysis/registration/registration.hpp"
 #include "analysis/registration/rigid_transform.hpp"
@@ -219,12 +220,14 @@ struct EmulatedUnit {
 // from the sail where the luff and foot touch them at model scale, and forward of
 // `max_x_m` (a mainsail's box ends at the mast: beyond it lie the mast's mixed
 // pixels and the headsail).
-Cloud cropToSail(const Cloud& cloud, const Mesh& design, double margin_m, double deck_z_m, double clearance_m,
-                 double max_x_m, const std::vector<Spar>& spars) {
-  Eigen::AlignedBox3d box;
-  for (const Vec3& v : design.vertices) box.extend(v);
-  box.min().array() -= margin_m;
-  box.max().array() += margin_m;
+// The box is what the database stores as the scan's region (re-analyses crop to it).
+RegionBox sailBox(const Mesh& design, double margin_m, double deck_z_m, double clearance_m, double max_x_m) {
+  RegionBox box = designRegion(design, margin_m);
+  box.min().z() = std::max(box.min().z(), deck_z_m + clearance_m);
+  box.max().x() = std::min(box.max().x(), max_x_m);
+  return box;
+}
+Cloud cropToSail(const Cloud& cloud, const RegionBox& box, double clearance_m, const std::vector<Spar>& spars) {
   auto nearSpar = [&](const Vec3& p) {
     for (const Spar& s : spars)
       if (distanceToSpar(p, s) < clearance_m) return true;
@@ -233,8 +236,7 @@ Cloud cropToSail(const Cloud& cloud, const Mesh& design, double margin_m, double
   std::vector<uint32_t> keep;
   for (size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3& p = cloud.points[i];
-    if (box.contains(p) && p.x() < max_x_m && p.z() > deck_z_m + clearance_m && !nearSpar(p))
-      keep.push_back(static_cast<uint32_t>(i));
+    if (box.contains(p) && !nearSpar(p)) keep.push_back(static_cast<uint32_t>(i));
   }
   Cloud out = selectPoints(cloud, keep);
   out.viewpoint = cloud.viewpoint;
@@ -361,6 +363,7 @@ struct UnitStep {
   BoatRegistration registration;
   RigidTransform used;  // scanner to boat frame: the stored registration
   Cloud boat_cloud;
+  RegionBox region;  // the sail's region in the boat frame, stored with the scan
   std::optional<SailAnalysis> analysis;  // empty when the analysis failed
   DesignComparison comparison;
   // For the simulated forces: the analysed sail's, or its design's when the analysis failed.
@@ -467,8 +470,8 @@ void analyseUnit(DemoRun& run, size_t i, int step, const Sweep& sweep, const std
   const double max_x = u.roi_ends_at_mast ? spars.front().base.x() : 1e9;
   // The whole scan loses its mixed pixels before the crop cuts off the surfaces behind
   // them that tell them apart (a sail's head seen against the other sail would keep a fringe).
-  const Cloud roi = cropToSail(withoutMixedPixels(out.boat_cloud, ap), u.design_mesh, 0.1, tunnel().hull.deck_z_m,
-                               3 * ap.sensor_sigma_m, max_x, spars);
+  out.region = sailBox(u.design_mesh, 0.1, tunnel().hull.deck_z_m, 3 * ap.sensor_sigma_m, max_x);
+  const Cloud roi = cropToSail(withoutMixedPixels(out.boat_cloud, ap), out.region, 3 * ap.sensor_sigma_m, spars);
   writeCloud(run.cloud_dir + "/step" + std::to_string(step + 1) + "-" + u.sail_file + "-roi.ply", roi);
   try {
     out.analysis = analyzeSail(roi, ap, run.progress);
@@ -550,6 +553,7 @@ void storeStep(DemoRun& run, Database& db, int step, const std::string& tag, con
                            {"partial", sweeps[i].partial},
                            {"start_spread_ms", us.row.start_spread_ms}};
     m.raw_capture = capturePath(run.capture_dir, step, u);
+    m.region = ScanRegion{us.region, currentDesignVersion(db, u.sail)};
     const json doc = us.analysis ? analysisToJson(*us.analysis) : json();
     const ImportResult r =
         importScan(db, m, us.analysis ? &doc : nullptr, &us.boat_cloud, {}, us.analysis ? &us.analysis->mesh : nullptr);
@@ -557,13 +561,8 @@ void storeStep(DemoRun& run, Database& db, int step, const std::string& tag, con
     us.row.scan_id = r.scan_id;
     run.result.scans.push_back(us.row);
     if (!us.analysis) continue;
-    json details = json::array();
-    for (const SectionDelta& d : us.comparison.sections)
-      details.push_back({{"fraction", d.fraction},
-                         {"design", sectionParametersToJson(d.design)},
-                         {"flying", sectionParametersToJson(d.flying)},
-                         {"delta", sectionParametersToJson(d.delta)}});
-    addDesignComparison(db, r.analysis_id, u.sail, us.comparison.stats, json{{"sections", details}});
+    addDesignComparison(db, r.analysis_id, u.sail, us.comparison.stats,
+                        json{{"sections", sectionDeltasToJson(us.comparison.sections)}});
     for (const SectionDelta& d : us.comparison.sections)
       run.result.sections.push_back({u.sail, step + 1, d.fraction, d.flying.camber_pct, d.flying.draft_pct,
                                      d.flying.twist_deg, d.delta.camber_pct, d.delta.draft_pct, d.delta.twist_deg});

@@ -13,6 +13,7 @@
 #include "analysis/pipeline/analysis_json.hpp"
 #include "cli/commands.hpp"
 #include "cli/json_file.hpp"
+#include "cli/sail_design.hpp"
 
 namespace sailshape::cli {
 namespace {
@@ -89,12 +90,18 @@ void runShow(const ShowOptions& o) {
   SectionParams sp;
   sp.count = o.sections;
   sp.sensor_sigma_m = 0;  // a design has no measurement noise
-  const MeshSections a = analyzeMeshSections(design.mesh, op, sp);
+  printDesignReport(o.input, design, analyzeMeshSections(design.mesh, op, sp), o.json_out);
+}
+
+}  // namespace
+
+void printDesignReport(const std::string& input, const DesignImport& design, const MeshSections& a,
+                       const std::string& json_out) {
   const SailOutline& ol = a.outline;
-  if (!o.json_out.empty()) {
+  if (!json_out.empty()) {
     nlohmann::json doc;
     auto vec = [](const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
-    doc["input"] = o.input;
+    doc["input"] = input;
     doc["format"] = design.format;
     doc["unit"] = design.unit;
     doc["axes"] = design.axes;
@@ -124,11 +131,11 @@ void runShow(const ShowOptions& o) {
     }
     doc["warnings"] = ol.warnings;
     for (const auto& w : a.sections.warnings) doc["warnings"].push_back(w);
-    writeJsonFile(o.json_out, doc);
-    std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());
+    writeJsonFile(json_out, doc);
+    std::fprintf(stderr, "wrote %s\n", json_out.c_str());
     return;
   }
-  std::printf("Design %s (%s): %zu faces, %zu triangles, %zu vertices\n", o.input.c_str(), design.format.c_str(),
+  std::printf("Design %s (%s): %zu faces, %zu triangles, %zu vertices\n", input.c_str(), design.format.c_str(),
               design.faces_read, design.mesh.triangles.size(), design.mesh.vertices.size());
   for (const auto& n : design.notes) std::printf("  %s\n", n.c_str());
   auto corner = [](const char* name, const Vec3& p) {
@@ -160,8 +167,6 @@ void runShow(const ShowOptions& o) {
     for (const auto& w : warnings) std::printf("  %s\n", w.c_str());
   }
 }
-
-}  // namespace
 
 void addDesignCommand(CLI::App& app) {
   CLI::App* design = app.add_subcommand(
@@ -229,14 +234,7 @@ void addDesignCommand(CLI::App& app) {
       "Read a design (.dxf 3DFACE as Sailcut CAD exports it, .obj, .stl, .ply), bring it into the boat frame in "
       "metres, and report what was assumed, its corners, edge lengths, area and per-section parameters.");
   show->add_option("FILE", s->input, "Design file: .dxf, .obj, .stl or .ply")->required();
-  show->add_option("--unit", s->unit, "File unit: auto (mm when the largest extent exceeds 100), m, mm or cm")
-      ->check(CLI::IsMember({"auto", "m", "mm", "cm"}))
-      ->capture_default_str();
-  show->add_option("--axes", s->axes,
-                   "File frame: auto (sailcut for DXF and Y-up meshes, else boat), boat (+X forward, +Y port, +Z up) "
-                   "or sailcut (X tack to clew, Y up, Z depth)")
-      ->check(CLI::IsMember({"auto", "boat", "sailcut"}))
-      ->capture_default_str();
+  addDesignFileOptions(show, s->unit, s->axes);
   show->add_option("--sections", s->sections, "Number of sections N, at t = k/(N+1) of luff and leech")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   sailshape::cli::addEmulateCommand(app);
   sailshape::cli::addScanCommand(app);
   sailshape::cli::addScannerCommand(app);
+  sailshape::cli::addCropCommand(app);
   sailshape::cli::addExamples(app);
   try {
     app.parse(argc, argv);

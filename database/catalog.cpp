@@ -28,6 +28,43 @@ void setIfGiven(Database& db, const char* column, const std::string& value, int6
     db.prepare(std::string("UPDATE sails SET ") + column + " = ? WHERE id = ?").bind(1, value).bind(2, id).run();
 }
 
+void checkDesignMesh(const Mesh& mesh) {
+  if (mesh.vertices.empty() || mesh.triangles.empty())
+    throw InvalidInput("[addDesignVersion] the design has no triangles (" + std::to_string(mesh.vertices.size()) +
+                       " vertices, " + std::to_string(mesh.triangles.size()) + " triangles)");
+  for (const Vec3& v : mesh.vertices)
+    if (!v.allFinite()) throw InvalidInput("[addDesignVersion] the design has a vertex that is not a finite number");
+}
+
+bool sameAsCurrentDesign(Database& db, int64_t sail_id, const Mesh& mesh) {
+  Statement s = db.prepare("SELECT mesh FROM design_versions WHERE sail_id = ? ORDER BY version DESC LIMIT 1");
+  s.bind(1, sail_id);
+  return s.step() && s.columnBlob(0) == packMesh(mesh);
+}
+
+// The sail's next design version, and the copy of it in the sail's row; inside the caller's transaction.
+int storeDesignVersion(Database& db, int64_t sail_id, const Mesh& mesh, const DesignSource& source,
+                       const nlohmann::json* params) {
+  checkDesignMesh(mesh);
+  Statement last = db.prepare("SELECT coalesce(max(version), 0) FROM design_versions WHERE sail_id = ?");
+  last.bind(1, sail_id).step();
+  const int version = static_cast<int>(last.columnInt(0)) + 1;
+  const std::vector<uint8_t> blob = packMesh(mesh);
+  Statement s = db.prepare(
+      "INSERT INTO design_versions(sail_id, version, source, format, unit, axes, mesh, params) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
+  s.bind(1, sail_id).bind(2, int64_t{version}).bind(3, source.file).bind(4, source.format).bind(5, source.unit);
+  s.bind(6, source.axes).bindBlob(7, blob);
+  if (params) s.bind(8, params->dump());
+  else s.bindNull(8);
+  s.run();
+  Statement row = db.prepare("UPDATE sails SET design_mesh = ?, design_params = ? WHERE id = ?");
+  row.bindBlob(1, blob);
+  if (params) row.bind(2, params->dump());
+  else row.bindNull(2);
+  row.bind(3, sail_id).run();
+  return version;
+}
+
 }  // namespace
 
 std::vector<uint8_t> packMesh(const Mesh& mesh) {
@@ -78,10 +115,64 @@ int64_t upsertSail(Database& db, const SailInfo& info, const Mesh* design_mesh, 
       db.prepare("INSERT INTO boats(name) VALUES (?) ON CONFLICT DO NOTHING").bind(1, info.boat).run();
       db.prepare("UPDATE sails SET boat_id = (SELECT id FROM boats WHERE name = ?) WHERE id = ?").bind(1, info.boat).bind(2, id).run();
     }
-    if (design_mesh) db.prepare("UPDATE sails SET design_mesh = ? WHERE id = ?").bindBlob(1, packMesh(*design_mesh)).bind(2, id).run();
-    if (design_params) db.prepare("UPDATE sails SET design_params = ? WHERE id = ?").bind(1, design_params->dump()).bind(2, id).run();
+    // The same design stored again (the demo stores its designs at every run) is not a new version.
+    if (design_mesh && !sameAsCurrentDesign(db, id, *design_mesh)) storeDesignVersion(db, id, *design_mesh, {}, design_params);
+    else if (design_params) db.prepare("UPDATE sails SET design_params = ? WHERE id = ?").bind(1, design_params->dump()).bind(2, id).run();
   });
   return id;
+}
+
+int addDesignVersion(Database& db, const std::string& sail, const Mesh& mesh, const DesignSource& source,
+                     const nlohmann::json* params) {
+  if (sail.empty()) throw InvalidInput("[addDesignVersion] sail name must not be empty");
+  int version = 0;
+  runTransaction(db, [&] {
+    db.prepare("INSERT INTO sails(name) VALUES (?) ON CONFLICT DO NOTHING").bind(1, sail).run();
+    version = storeDesignVersion(db, sailId(db, sail, "addDesignVersion"), mesh, source, params);
+  });
+  return version;
+}
+
+std::vector<DesignVersion> designVersions(Database& db, const std::string& sail) {
+  const int64_t id = sailId(db, sail, "designVersions");
+  Statement s = db.prepare(
+      "SELECT version, added_at, source, format, unit, axes, mesh FROM design_versions WHERE sail_id = ? ORDER BY version");
+  s.bind(1, id);
+  std::vector<DesignVersion> out;
+  while (s.step()) {
+    DesignVersion v;
+    v.version = static_cast<int>(s.columnInt(0));
+    v.added_at = s.columnText(1);
+    v.source = {s.columnText(2), s.columnText(3), s.columnText(4), s.columnText(5)};
+    const Mesh m = unpackMesh(s.columnBlob(6));
+    v.vertices = m.vertices.size();
+    v.triangles = m.triangles.size();
+    out.push_back(v);
+  }
+  if (!out.empty()) out.back().current = true;
+  return out;
+}
+
+Mesh designVersionMesh(Database& db, const std::string& sail, int version) {
+  const int64_t id = sailId(db, sail, "designVersionMesh");
+  if (version < 0) throw InvalidInput("[designVersionMesh] design version must be >= 1 (got " + std::to_string(version) + ")");
+  Statement s = db.prepare(version == 0
+                               ? "SELECT mesh FROM design_versions WHERE sail_id = ? ORDER BY version DESC LIMIT 1"
+                               : "SELECT mesh FROM design_versions WHERE sail_id = ? AND version = ?");
+  s.bind(1, id);
+  if (version) s.bind(2, int64_t{version});
+  if (!s.step())
+    throw InvalidInput(version == 0 ? "sail \"" + sail + "\" has no design (store one with `sailshape db design add`)"
+                                    : "sail \"" + sail + "\" has no design version " + std::to_string(version));
+  return unpackMesh(s.columnBlob(0));
+}
+
+int currentDesignVersion(Database& db, const std::string& sail) {
+  Statement s = db.prepare(
+      "SELECT max(v.version) FROM design_versions v JOIN sails s ON s.id = v.sail_id WHERE s.name = ?");
+  s.bind(1, sail);
+  if (!s.step() || s.isNull(0)) return 0;
+  return static_cast<int>(s.columnInt(0));
 }
 
 Mesh sailDesignMesh(Database& db, const std::string& sail) {

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
@@ -20,13 +21,41 @@ struct SailInfo {
   std::string boat;                                   // empty: left as stored; created when new
 };
 
-// Creates or updates the sail `info.name`; stores the design mesh and design
-// parameters when given. Returns the sail's id. One transaction.
+// Creates or updates the sail `info.name`; a design mesh that differs from the
+// sail's current one is stored as its next design version (addDesignVersion), with
+// the parameters when given. Returns the sail's id. One transaction.
 int64_t upsertSail(Database& db, const SailInfo& info, const Mesh* design_mesh = nullptr,
                    const nlohmann::json* design_params = nullptr);
 
-// The stored design mesh of `sail`; throws InvalidInput when the sail or its design is missing.
+// The sail's current design mesh (its highest design version); throws InvalidInput when the sail or its design is missing.
 Mesh sailDesignMesh(Database& db, const std::string& sail);
+
+// Where a design version came from: the file and what the importer applied
+// (analysis/io/design_import.hpp); empty when unknown.
+struct DesignSource {
+  std::string file, format, unit, axes;
+};
+
+struct DesignVersion {
+  int version = 0;             // 1, 2, ... per sail; the highest is current
+  std::string added_at;        // ISO 8601, UTC
+  DesignSource source;
+  size_t vertices = 0, triangles = 0;
+  bool current = false;
+};
+
+// Stores `mesh` (metres, boat frame) as the sail's next design version and makes it
+// current, in one transaction; the sail is created when new. Returns the version.
+// Throws InvalidInput for an empty mesh or a non-finite vertex.
+int addDesignVersion(Database& db, const std::string& sail, const Mesh& mesh, const DesignSource& source,
+                     const nlohmann::json* params = nullptr);
+// The sail's design versions, oldest first; throws InvalidInput when there is no such sail.
+std::vector<DesignVersion> designVersions(Database& db, const std::string& sail);
+// Version `version` of the sail's design (0: the current one); throws InvalidInput
+// when the sail or the version is missing.
+Mesh designVersionMesh(Database& db, const std::string& sail, int version = 0);
+// The sail's current design version number; 0 when it has none (or no such sail).
+int currentDesignVersion(Database& db, const std::string& sail);
 
 // Mesh blob: "SSM1", uint64 vertex count, uint64 triangle count, float64 xyz (metres), uint32 indices.
 std::vector<uint8_t> packMesh(const Mesh& mesh);

@@ -27,6 +27,7 @@ const std::vector<TableSpec>& tables() {
       {"campaigns", true, {}, {"name"}, "id"},
       {"boats", true, {}, {"name"}, "id"},
       {"sails", true, {{"boat_id", "boats"}}, {"name"}, "id"},
+      {"design_versions", true, {{"sail_id", "sails"}}, {"sail_id", "version"}, "id"},
       {"scanner_units", true, {}, {"serial"}, "id"},
       {"calibrations", true, {{"unit_id", "scanner_units"}}, {}, "id"},
       {"sessions", true, {{"campaign_id", "campaigns"}}, {"campaign_id", "name"}, "id"},

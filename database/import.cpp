@@ -1,4 +1,5 @@
 #include "database/import.hpp"
+#include "database/catalog.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -228,8 +229,9 @@ void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json*
     point_count = d.value("points_in", size_t{0});
   }
   Statement s = db.prepare(
-      "INSERT INTO scans(trim_step_id, unit_id, scanned_at, settings, raw_capture, cloud, point_count)"
-      " VALUES (?, ?, ?, ?, ?, ?, ?)");
+      "INSERT INTO scans(trim_step_id, unit_id, scanned_at, settings, raw_capture, cloud, point_count, region)"
+      " VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
+  if (meta.region) s.bind(8, regionToJson(*meta.region).dump()); else s.bindNull(8);
   s.bind(1, result.trim_step_id);
   if (unit_id) s.bind(2, *unit_id); else s.bindNull(2);
   if (meta.scanned_at.empty()) s.bindNull(3); else s.bind(3, meta.scanned_at);
@@ -245,6 +247,8 @@ void writeImport(Database& db, const ImportMetadata& meta, const nlohmann::json*
         writeAnalysis(db, result.scan_id, *analysis, meta.software_version, surface_blob, "importScan",
                       &result.sections, hook);
     if (hook) hook("sections");
+    if (meta.design_comparison)
+      addDesignComparison(db, result.analysis_id, meta.sail, meta.design_comparison->stats, meta.design_comparison->details);
   }
 }
 

@@ -13,6 +13,8 @@
 
 #include "analysis/core/cloud.hpp"
 #include "analysis/core/mesh.hpp"
+#include "analysis/design/design_compare.hpp"
+#include "database/scan_record.hpp"
 #include "database/sqlite.hpp"
 
 namespace sailshape {
@@ -37,6 +39,15 @@ struct ImportMetadata {
   nlohmann::json settings;                   // acquisition settings
   std::string raw_capture;                   // reference to the raw capture
   std::string software_version = "0.1.0";
+  // The region the sail flies in (database/scan_record.hpp ScanRegion); every
+  // re-analysis of the stored cloud crops to it.
+  std::optional<ScanRegion> region;
+  // The analysis against the sail's current design, stored with it (design_comparisons).
+  struct Comparison {
+    DistanceStats stats;
+    nlohmann::json details;  // e.g. {"sections": analysis_json sectionDeltasToJson}
+  };
+  std::optional<Comparison> design_comparison;
 };
 
 struct ImportResult {

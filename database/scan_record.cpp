@@ -27,10 +27,29 @@ SectionParameters readParameters(const Statement& s, int first) {
 
 }  // namespace
 
+nlohmann::json regionToJson(const ScanRegion& region) {
+  const Eigen::AlignedBox3d& b = region.box;
+  return {{"box_m", {b.min().x(), b.max().x(), b.min().y(), b.max().y(), b.min().z(), b.max().z()}},
+          {"design_version", region.design_version}};
+}
+
+std::optional<ScanRegion> regionFromJson(const nlohmann::json& j) {
+  if (!j.is_object() || !j.contains("box_m") || !j["box_m"].is_array() || j["box_m"].size() != 6) return std::nullopt;
+  ScanRegion r;
+  for (int a = 0; a < 3; ++a) {
+    const nlohmann::json &lo = j["box_m"][2 * a], &hi = j["box_m"][2 * a + 1];
+    if (!lo.is_number() || !hi.is_number()) return std::nullopt;
+    r.box.min()[a] = lo.get<double>();
+    r.box.max()[a] = hi.get<double>();
+  }
+  if (j.contains("design_version") && j["design_version"].is_number_integer()) r.design_version = j["design_version"].get<int>();
+  return r;
+}
+
 ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
   Statement s = db.prepare(
       "SELECT s.id, s.trim_step_id, s.scanned_at, s.cloud, c.name, t.test, t.step_order, t.awa_deg, sa.name,"
-      " sa.design_mesh IS NOT NULL, (SELECT max(a.id) FROM analyses a WHERE a.scan_id = s.id), s.settings"
+      " sa.design_mesh IS NOT NULL, (SELECT max(a.id) FROM analyses a WHERE a.scan_id = s.id), s.settings, s.region"
       " FROM scans s LEFT JOIN trim_steps t ON t.id = s.trim_step_id LEFT JOIN sessions se ON se.id = t.session_id"
       " LEFT JOIN campaigns c ON c.id = se.campaign_id LEFT JOIN sails sa ON sa.id = t.sail_id WHERE s.id = ?");
   s.bind(1, scan_id);
@@ -49,6 +68,7 @@ ScanRecord loadScanRecord(Database& db, int64_t scan_id) {
   r.analysis_id = s.isNull(10) ? 0 : s.columnInt(10);
   if (!s.isNull(11)) r.settings = nlohmann::json::parse(s.columnText(11), nullptr, false);
   if (r.settings.is_discarded()) r.settings = nullptr;
+  if (!s.isNull(12)) r.region = regionFromJson(nlohmann::json::parse(s.columnText(12), nullptr, false));
   Statement g = db.prepare("SELECT id FROM registrations WHERE scan_id = ? LIMIT 1");
   g.bind(1, scan_id);
   if (g.step()) r.registration = scanTransform(db, scan_id);

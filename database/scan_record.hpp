@@ -8,6 +8,7 @@
 // The full json header, not json_fwd.hpp: ScanRecord holds json values (its
 // parameters and settings), which need the complete type.
 #include <nlohmann/json.hpp>
+#include <Eigen/Geometry>
 
 #include "analysis/core/cloud.hpp"
 #include "analysis/core/mesh.hpp"
@@ -15,6 +16,17 @@
 #include "database/sqlite.hpp"
 
 namespace sailshape {
+
+// The box a scan's sail flies in (boat frame, metres: its design's box grown by a
+// margin), from the design version it was drawn around (0: none stored).
+struct ScanRegion {
+  Eigen::AlignedBox3d box;
+  int design_version = 0;
+};
+// {"box_m": [xmin, xmax, ymin, ymax, zmin, zmax], "design_version": n}, as scans.region holds it.
+nlohmann::json regionToJson(const ScanRegion& region);
+// Empty for null or a document that is not a region.
+std::optional<ScanRegion> regionFromJson(const nlohmann::json& j);
 
 struct ScanRecord {
   int64_t scan_id = 0;
@@ -33,6 +45,7 @@ struct ScanRecord {
   nlohmann::json analysis_params;  // the pipeline parameters it ran with (null when unknown)
   nlohmann::json settings;         // the acquisition settings stored with the scan (null when none)
   std::optional<Eigen::Matrix4d> registration;  // the latest scanner-to-boat transform, when registered
+  std::optional<ScanRegion> region;             // where the sail flies; empty: the whole cloud
 };
 
 // The id of scan `scan_id`'s latest analysis; 0 when it has none.

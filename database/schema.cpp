@@ -125,6 +125,24 @@ CREATE INDEX design_comparisons_analysis ON design_comparisons(analysis_id);
     R"sql(
 ALTER TABLE analyses ADD COLUMN surface_mesh BLOB;  -- catalog.hpp packMesh: metres, boat frame; NULL: not stored
 )sql",
+    // 5: design versions per sail, and the region a scan's sail lies in. A sail's
+    // stored design becomes its version 1; sails.design_mesh and design_params keep
+    // a copy of the current (highest) version for readers of the sail row.
+    R"sql(
+CREATE TABLE design_versions (
+  id INTEGER PRIMARY KEY,
+  sail_id INTEGER NOT NULL REFERENCES sails(id) ON DELETE CASCADE,
+  version INTEGER NOT NULL,
+  added_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ', 'now')),
+  source TEXT,              -- the file it was read from
+  format TEXT, unit TEXT, axes TEXT,  -- as analysis/io/design_import.hpp applied them
+  mesh BLOB NOT NULL,       -- database/catalog.hpp packMesh, metres, boat frame
+  params TEXT,              -- JSON
+  UNIQUE (sail_id, version));
+INSERT INTO design_versions(sail_id, version, source, mesh, params)
+  SELECT id, 1, 'stored with the sail', design_mesh, design_params FROM sails WHERE design_mesh IS NOT NULL;
+ALTER TABLE scans ADD COLUMN region TEXT;  -- JSON {"box_m": [xmin, xmax, ymin, ymax, zmin, zmax], "design_version": n}
+)sql",
 };
 
 }  // namespace

@@ -7,7 +7,7 @@
 namespace sailshape {
 
 // The schema version this build writes; version 0 is an empty file.
-constexpr int kSchemaVersion = 4;
+constexpr int kSchemaVersion = 5;
 
 // Brings the schema from its current user_version up to `target_version`, each
 // step in its own transaction (a failed step leaves the previous version).

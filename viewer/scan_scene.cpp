@@ -3,6 +3,7 @@
 #include <numeric>
 
 #include "analysis/core/errors.hpp"
+#include "analysis/pipeline/sail_region.hpp"
 #include "viewer/worker.hpp"
 
 namespace sailshape::viewer {
@@ -17,6 +18,20 @@ Cloud thinCloud(const Cloud& cloud, size_t max_points) {
   return selectPoints(cloud, keep);
 }
 
+namespace {
+
+// The stored scan as its sail: within its stored region (where the sail flies) and
+// picked by its design when there is one; a scan stored without a region, within the
+// options' box.
+SailAnalysis analyzeStoredScan(const Cloud& cloud, const std::optional<ScanRegion>& region, const Mesh* design,
+                               const SceneOptions& options, const Progress& progress) {
+  if (region && design && !design->empty()) return analyzeInRegion(cloud, region->box, *design, options.analysis, progress);
+  const Cloud clean = withoutMixedPixels(cloud, options.analysis);
+  return analyzeSail(region ? cropToRegion(clean, region->box) : cropToBox(clean, options.roi), options.analysis, progress);
+}
+
+}  // namespace
+
 ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const SceneOptions& options,
                          const Progress& progress) {
   ScanScene scene;
@@ -25,8 +40,7 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
     scene.raw_cloud = thinCloud(*record.cloud, options.max_cloud_points);
     if (options.analyze_cloud) {
       try {
-        scene.analysis = analyzeSail(cropToBox(withoutMixedPixels(*record.cloud, options.analysis), options.roi),
-                                     options.analysis, progress);
+        scene.analysis = analyzeStoredScan(*record.cloud, record.region, design ? &*design : nullptr, options, progress);
         scene.surface = scene.analysis->mesh;
       } catch (const Cancelled&) {
         throw;
@@ -81,6 +95,8 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
       const MeshSections ms = analyzeMeshSections(scene.design, OutlineParams{}, sp);
       scene.design_sections = ms.sections;
       scene.deltas = sectionDeltas(scene.design_sections, scene.sections);
+      if (scene.analysis && scene.deviation)
+        scene.design_mismatch = designMismatch(scene.design, ms, *scene.analysis, *scene.deviation);
     } catch (const Cancelled&) {
       throw;
     } catch (const std::exception& e) {

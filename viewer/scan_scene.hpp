@@ -37,6 +37,10 @@ struct ScanScene {
   SectionAnalysis design_sections;          // at the fractions of `sections`
   std::vector<SectionDelta> deltas;         // flying − design, per section
   std::optional<DistanceStats> deviation;   // of the surface (or the raw cloud without one)
+  // Why the analysed sail is not the one its design describes (analysis/pipeline/
+  // sail_region.hpp designMismatch), for the viewer to show in red; empty when it
+  // flies as its design could at a plausible trim, or without an analysis or design.
+  std::string design_mismatch;
   std::vector<std::string> warnings;        // what could not be computed, and why
 };
 

@@ -154,4 +154,14 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
   return j;
 }
 
+nlohmann::json sectionDeltasToJson(const std::vector<SectionDelta>& deltas) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const SectionDelta& d : deltas)
+    out.push_back({{"fraction", d.fraction},
+                   {"design", sectionParametersToJson(d.design)},
+                   {"flying", sectionParametersToJson(d.flying)},
+                   {"delta", sectionParametersToJson(d.delta)}});
+  return out;
+}
+
 }  // namespace sailshape

@@ -180,7 +180,7 @@ const std::map<std::string, ParamNote>& paramNotes() {
       {"region_growing.max_curvature", {"-", "largest curvature (surface variation) of a point that grows on"}},
       {"region_growing.min_points", {"points", "smallest region kept"}},
       {"region_growing.max_points", {"points", "largest region kept"}},
-      {"sail_pick.method", {"-", "which region is the sail: auto, seed (seed_point) or index (cluster_index)"}},
+      {"sail_pick.method", {"-", "which region is the sail: auto, seed (seed_point), index (cluster_index) or design (set by --design)"}},
       {"sail_pick.seed_point", {"m", "[x, y, z] of a point on the sail, for method seed"}},
       {"sail_pick.cluster_index", {"-", "region by size (0: largest), for method index"}},
       {"sail_pick.min_depth_m", {"m", "least camber depth of a sail (flatter: a wall)"}},

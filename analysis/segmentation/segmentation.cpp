@@ -4,9 +4,11 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <unordered_map>
 
 #include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
+#include "analysis/spatial/neighbours.hpp"
 #include "analysis/spatial/principal_axes.hpp"
 
 namespace sailshape {
@@ -178,6 +180,51 @@ std::vector<uint32_t> addClusterFringe(const Segmentation& seg, size_t cluster, 
   return members;
 }
 
+namespace {
+
+// Points of each cluster within p.design_match_m of a design point, found in a
+// voxel hash of the design points whose cells are design_match_m wide (a point's
+// match lies in its own cell or a neighbour).
+size_t designMatchedCluster(const Cloud& cloud, const Segmentation& seg, const std::vector<ClusterInfo>& info,
+                            const SailPickParams& p) {
+  if (p.design_points.empty()) throw InvalidInput("[pickSailCluster] method design needs the design's points");
+  if (!(p.design_match_m > 0 && std::isfinite(p.design_match_m)))
+    throw InvalidInput("[pickSailCluster] design_match_m must be > 0 (got " + std::to_string(p.design_match_m) + ")");
+  const double cell = p.design_match_m, limit2 = cell * cell;
+  std::unordered_map<int64_t, std::vector<uint32_t>> grid;
+  for (uint32_t i = 0; i < p.design_points.size(); ++i) grid[voxelKey(p.design_points[i], cell)].push_back(i);
+  auto near = [&](const Vec3& q) {
+    const Eigen::Vector3i c = voxelOf(q, cell);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find(voxelKey(Eigen::Vector3i(c + Eigen::Vector3i(dx, dy, dz))));
+          if (it == grid.end()) continue;
+          for (uint32_t j : it->second)
+            if ((p.design_points[j] - q).squaredNorm() <= limit2) return true;
+        }
+    return false;
+  };
+  size_t best = 0, best_count = 0;
+  bool best_sail_like = false;
+  for (size_t c = 0; c < seg.clusters.size(); ++c) {
+    size_t count = 0;
+    for (uint32_t i : seg.clusters[c]) count += near(cloud.points[i]) ? 1 : 0;
+    const bool sail_like = info[c].sail_like;
+    if (count > 0 && ((sail_like && !best_sail_like) || (sail_like == best_sail_like && count > best_count))) {
+      best = c;
+      best_count = count;
+      best_sail_like = sail_like;
+    }
+  }
+  if (best_count == 0)
+    throw AnalysisError("no part of the scan lies within " + std::to_string(static_cast<int>(std::lround(1000 * cell))) +
+                        " mm of the sail's design (a plausible trim): the scan does not hold this sail");
+  return best;
+}
+
+}  // namespace
+
 SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const SailPickParams& p) {
   if (seg.clusters.empty()) throw AnalysisError("[pickSailCluster] segmentation found no cluster to pick a sail from");
   if (!(p.min_width_ratio >= 0 && p.min_width_ratio < 1))
@@ -255,8 +302,10 @@ SailPick pickSailCluster(const Cloud& cloud, const Segmentation& seg, const Sail
       throw AnalysisError("[pickSailCluster] no sail-like cluster among " + std::to_string(seg.clusters.size()) +
                           " (" + why + ")");
     }
+  } else if (p.method == "design") {
+    pick.cluster = designMatchedCluster(cloud, seg, pick.candidates, p);
   } else {
-    throw InvalidInput("[pickSailCluster] method must be auto, seed or index (got '" + p.method + "')");
+    throw InvalidInput("[pickSailCluster] method must be auto, seed, index or design (got '" + p.method + "')");
   }
   if (!pick.candidates[pick.cluster].sail_like)
     pick.warnings.push_back("picked cluster " + std::to_string(pick.cluster) + " does not look like a sail (" +

@@ -71,7 +71,10 @@ struct ClusterInfo {
 // wall: a wall's spread off its plane is noise that no smooth bend takes away, while
 // a flat, tall mainsail spreads little more than a wall of its size would by noise
 // and systematic error. A seed point picks the cluster holding the point nearest
-// to it; an index picks that cluster directly.
+// to it; an index picks that cluster directly. "design" picks the sail-like cluster with
+// the most points within design_match_m of the design (any cluster when none is
+// sail-like): another sail in the region lies farther from this one's design than
+// any trim puts this one.
 struct SailPickParams {
   std::string method = "auto";          // auto | seed | index
   std::vector<double> seed_point;       // [x, y, z] for "seed"
@@ -84,6 +87,11 @@ struct SailPickParams {
   double max_tilt_deg = 60.0;
   // Sails are at least a sixth as wide as tall (a blade jib); a mast is 1 %.
   double min_width_ratio = 0.08;
+  // For "design": points on the sail's design surface (boat frame, metres, no farther
+  // apart than design_match_m; set in code, not read from a params file) and how far
+  // from it a sail flying at any plausible trim may lie (analysis/pipeline/sail_region.hpp).
+  std::vector<Vec3> design_points;
+  double design_match_m = 0;
 };
 
 struct SailPick {

@@ -96,8 +96,8 @@ void collectHelps(const fs::path& dir, const std::string& path, std::vector<std:
 TEST_F(Cli, EveryCommandsHelpEndsWithExamplesOfItself) {
   std::vector<std::pair<std::string, std::string>> helps;
   collectHelps(dir_, "", helps);
-  // sailshape, its 13 commands, design's 2, db's 9 and scanner's 1.
-  ASSERT_EQ(helps.size(), 26u);
+  // sailshape, its 14 commands, design's 2, db's 10, db design's 4 and scanner's 1.
+  ASSERT_EQ(helps.size(), 32u);
   for (const auto& [path, help] : helps) {
     const size_t examples = help.find("\nExamples:\n");
     ASSERT_NE(examples, std::string::npos) << "`sailshape " << path << " --help` has no examples:\n" << help;
@@ -139,7 +139,8 @@ TEST_F(Cli, ExamplesRunAsWritten) {
   const std::string bin_dir = fs::path(SAILSHAPE_BIN).parent_path().string();
   int ran = 0;
   for (const char* command : {"analyze", "simulate", "design", "design new", "design show", "compare", "fit", "db", "db init",
-                              "db import", "db list", "db show", "db query", "db export", "db check", "db backup", "db copy"}) {
+                              "db import", "db list", "db show", "db query", "db export", "db check", "db backup", "db copy",
+                              "db design", "db design add", "db design list", "db design show", "db design export", "crop"}) {
     const Outcome help = sailshape(std::string(command) + " --help");
     for (const std::string& example : examplesOf(help.out)) {
       if (example.find("demo-output") != std::string::npos) continue;  // needs `sailshape demo` first
@@ -168,7 +169,7 @@ TEST_F(Cli, CommandListsHaveOneShortLinePerCommand) {
   EXPECT_NE(analyze.out.find("mixed pixels"), std::string::npos) << analyze.out;
   EXPECT_EQ(top.out.find("mixed pixels"), std::string::npos) << top.out;
   // Every list of subcommands (db's, design's, scanner's) keeps to a line each.
-  for (const char* parent : {"db", "design", "scanner"}) {
+  for (const char* parent : {"db", "db design", "design", "scanner"}) {
     const Outcome r = sailshape(std::string(parent) + " --help");
     bool in_list = false;
     for (const std::string& line : lines(r.out)) {
@@ -214,7 +215,8 @@ TEST_F(Cli, AnalyzeHelpMentionsEveryOption) {
   const Outcome r = sailshape("analyze --help");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   expectMentions(r.out, {"INPUT", "--sections", "--at", "--plane", "--json", "--mesh", "--sail-cloud", "--params",
-                         "--corners", "--scanner", "--sky", "--no-segment", "--print-params", "-q", "--quiet"});
+                         "--corners", "--scanner", "--sky", "--no-segment", "--print-params", "-q", "--quiet", "--design",
+                         "--margin"});
 }
 
 TEST_F(Cli, SimulateHelpMentionsEveryOption) {

@@ -12,11 +12,48 @@ namespace {
 
 using test::TempDir;
 
+int64_t scalar(Database& db, const std::string& sql) {
+  Statement s = db.prepare(sql);
+  s.step();
+  return s.columnInt(0);
+}
+
 Mesh square() {
   Mesh m;
   m.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 0, 1), Vec3(0, 0.1, 1)};
   m.triangles = {{0, 1, 2}, {0, 2, 3}};
   return m;
+}
+
+// `db design add` on a sail: each call a new version, the sail created when new;
+// a design without triangles or with a NaN vertex stores nothing at all.
+TEST(Catalog, DesignVersionsCountUpAndBadDesignsStoreNothing) {
+  TempDir dir;
+  Database db = openSailDatabase(dir.file("v.db"));
+  EXPECT_THROW(designVersions(db, "Main"), InvalidInput);
+  EXPECT_THROW(designVersionMesh(db, "Main"), InvalidInput);
+  EXPECT_EQ(currentDesignVersion(db, "Main"), 0);
+  Mesh empty;
+  EXPECT_THROW(addDesignVersion(db, "Main", empty, {}), InvalidInput);
+  Mesh nan = square();
+  nan.vertices[1].x() = std::nan("");
+  EXPECT_THROW(addDesignVersion(db, "Main", nan, {}), InvalidInput);
+  EXPECT_THROW(addDesignVersion(db, "", square(), {}), InvalidInput);
+  EXPECT_EQ(scalar(db, "SELECT count(*) FROM sails"), 0) << "a refused design created its sail";
+  EXPECT_EQ(addDesignVersion(db, "Main", square(), {"a.obj", "obj", "m", "boat"}), 1);
+  EXPECT_EQ(addDesignVersion(db, "Main", square(), {"b.dxf", "dxf", "mm", "sailcut"}), 2);
+  EXPECT_THROW(addDesignVersion(db, "Main", nan, {}), InvalidInput);
+  EXPECT_EQ(currentDesignVersion(db, "Main"), 2);
+  EXPECT_THROW(designVersionMesh(db, "Main", 3), InvalidInput);
+  const std::vector<DesignVersion> v = designVersions(db, "Main");
+  ASSERT_EQ(v.size(), 2u);
+  EXPECT_EQ(v[1].source.format, "dxf");
+  EXPECT_EQ(v[1].source.unit, "mm");
+  EXPECT_EQ(v[1].triangles, 2u);
+  // The demo stores its designs at every run: the same mesh again is no new version.
+  const Mesh same = square();
+  upsertSail(db, {"Main", "", "", "", "", ""}, &same);
+  EXPECT_EQ(currentDesignVersion(db, "Main"), 2);
 }
 
 TEST(Catalog, SailWithDesignMeshAndParameters) {

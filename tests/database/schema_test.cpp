@@ -38,7 +38,7 @@ TEST(Schema, NewDatabaseIsAtCurrentVersionWithWalAndForeignKeys) {
   EXPECT_EQ(fk.columnInt(0), 1);
   for (const char* t : {"campaigns", "boats", "sails", "scanner_units", "calibrations", "sessions", "scans",
                         "registrations", "trim_steps", "control_settings", "pressures", "analyses", "sections",
-                        "design_comparisons"})
+                        "design_comparisons", "design_versions"})
     EXPECT_TRUE(hasTable(db, t)) << t;
   EXPECT_TRUE(db.integrityCheck().empty());
   // Foreign keys are enforced.
@@ -58,6 +58,7 @@ TEST(Schema, MigratesFromEveryOlderVersionKeepingData) {
     Database db = openSailDatabase(path);
     EXPECT_EQ(db.userVersion(), kSchemaVersion) << "from " << from;
     EXPECT_TRUE(hasTable(db, "design_comparisons")) << "from " << from;
+    EXPECT_TRUE(hasTable(db, "design_versions")) << "from " << from;
     Statement idx = db.prepare("SELECT count(*) FROM sqlite_schema WHERE type = 'index' AND name = 'trim_steps_sail_awa'");
     idx.step();
     EXPECT_EQ(idx.columnInt(0), 1) << "from " << from;

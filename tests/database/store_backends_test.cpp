@@ -5,6 +5,7 @@
 #include <random>
 
 #include "analysis/core/errors.hpp"
+#include "database/catalog.hpp"
 #include "database/copy.hpp"
 #include "database/import.hpp"
 #include "database/queries.hpp"
@@ -112,7 +113,7 @@ TEST_P(Store, NewStoreIsAtTheCurrentVersionAndChecksClean) {
   Database db = openSailDatabase(location_);
   EXPECT_EQ(db.backend(), GetParam());
   EXPECT_EQ(db.userVersion(), kSchemaVersion);
-  EXPECT_EQ(db.tableCount(), 14);
+  EXPECT_EQ(db.tableCount(), 15);
   EXPECT_TRUE(db.integrityCheck().empty());
   // Opening again migrates nothing and keeps the version.
   Database again = openSailDatabase(location_);
@@ -148,6 +149,61 @@ TEST_P(Store, MigratesFromEveryOlderVersionKeepingData) {
     expectSameMesh(analysisSurface(db, r.analysis_id), surface);
     EXPECT_TRUE(db.integrityCheck().empty()) << "from " << from;
   }
+}
+
+// A design stored in a sail's row before design versions (schema 3) becomes the
+// sail's version 1, byte for byte, and stays its current design; scans keep their rows.
+TEST_P(Store, MigrationToDesignVersionsKeepsTheStoredDesignAsVersionOne) {
+  Mesh design;
+  design.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.2, 0.1, 3)};
+  design.triangles = {{0, 1, 2}};
+  {
+    Database raw(location_);
+    migrateSchema(raw, 3);
+    raw.prepare("INSERT INTO sails(name, design_mesh, design_params) VALUES ('Old main', ?, '{\"luff_m\": 3}')")
+        .bindBlob(1, packMesh(design))
+        .run();
+    raw.exec("INSERT INTO sails(name) VALUES ('No design')");
+    raw.exec("INSERT INTO scans(point_count) VALUES (5)");
+  }
+  Database db = openSailDatabase(location_);
+  EXPECT_EQ(db.userVersion(), kSchemaVersion);
+  EXPECT_EQ(currentDesignVersion(db, "Old main"), 1);
+  EXPECT_EQ(currentDesignVersion(db, "No design"), 0);
+  EXPECT_EQ(packMesh(designVersionMesh(db, "Old main", 1)), packMesh(design));
+  EXPECT_EQ(scalar(db, "SELECT count(*) FROM design_versions"), 1);
+  EXPECT_EQ(scalar(db, "SELECT count(*) FROM scans WHERE point_count = 5 AND region IS NULL"), 1);
+  // A new version becomes current for every reader of the sail row.
+  Mesh v2 = design;
+  v2.vertices[2].z() = 3.5;
+  EXPECT_EQ(addDesignVersion(db, "Old main", v2, {"v2.obj", "obj", "m", "boat"}), 2);
+  EXPECT_DOUBLE_EQ(sailDesignMesh(db, "Old main").vertices[2].z(), 3.5);
+  EXPECT_DOUBLE_EQ(designVersionMesh(db, "Old main", 1).vertices[2].z(), 3.0);
+  const std::vector<DesignVersion> versions = designVersions(db, "Old main");
+  ASSERT_EQ(versions.size(), 2u);
+  EXPECT_FALSE(versions[0].current);
+  EXPECT_TRUE(versions[1].current);
+  EXPECT_EQ(versions[1].source.file, "v2.obj");
+  EXPECT_TRUE(db.integrityCheck().empty());
+}
+
+// A scan's region goes in with the import and comes back with the record.
+TEST_P(Store, AScanKeepsItsRegion) {
+  Database db = openSailDatabase(location_);
+  ImportMetadata m;
+  m.sail = "Main";
+  m.region = ScanRegion{Eigen::AlignedBox3d(Vec3(-1, -0.5, 0.2), Vec3(0.1, 0.3, 3.2)), 2};
+  Cloud cloud;
+  cloud.points = {Vec3(0, 0, 1), Vec3(0, 0.1, 1)};
+  const ImportResult r = importScan(db, m, nullptr, &cloud);
+  const ScanRecord record = loadScanRecord(db, r.scan_id);
+  ASSERT_TRUE(record.region.has_value());
+  EXPECT_EQ(record.region->design_version, 2);
+  EXPECT_TRUE(record.region->box.min().isApprox(Vec3(-1, -0.5, 0.2)));
+  EXPECT_TRUE(record.region->box.max().isApprox(Vec3(0.1, 0.3, 3.2)));
+  m.region.reset();
+  m.trim_step = 1;
+  EXPECT_FALSE(loadScanRecord(db, importScan(db, m, nullptr, &cloud).scan_id).region.has_value());
 }
 
 TEST_P(Store, NewerSchemaAndForeignTablesAreRefusedAndLeftAsTheyWere) {

@@ -179,7 +179,7 @@ TEST_P(StoreConcurrency, StoresOpenedFirstByManyAtOnceAreMigratedOnce) {
   for (auto& t : threads) t.join();
   for (int i = 0; i < kOpeners; ++i) EXPECT_EQ(errors[i], "") << "opener " << i;
   Database db = openSailDatabase(location_);
-  EXPECT_EQ(db.tableCount(), 14);
+  EXPECT_EQ(db.tableCount(), 15);
   EXPECT_TRUE(db.integrityCheck().empty());
 }
 

@@ -2,6 +2,7 @@
 
 #include "analysis/core/errors.hpp"
 #include "analysis/design/sail_generator.hpp"
+#include "analysis/pipeline/sail_region.hpp"
 #include "database/catalog.hpp"
 #include "database/import.hpp"
 #include "database/scan_record.hpp"
@@ -45,6 +46,58 @@ TEST(ScanScene, FindsTheKnownTrimAgainstTheDesign) {
   ASSERT_TRUE(scene.deviation.has_value());
   EXPECT_GT(scene.deviation->mean_m, 0.0);
   EXPECT_GT(scene.deviation->p5_m, -3 * test::kSensorSigmaM);
+  // Camber +2 % and twist +3° are a plausible trim: no mismatch to show in red.
+  EXPECT_EQ(scene.design_mismatch, "");
+}
+
+// The same scan against its design grown 1.3× about the tack: area and edges beyond
+// a plausible trim (±20 %, ±10 %), a message the viewer shows in red.
+TEST(ScanScene, ASailFarFromItsDesignGivesTheMismatch) {
+  test::TempDir dir;
+  const std::string path = dir.file("s.sqlite");
+  test::makeSailDatabase(path, 1);
+  Database db = openSailDatabase(path);
+  const ScanRecord record = loadScanRecord(db, 1);
+  Mesh design = sailDesignMesh(db, record.sail);
+  Eigen::AlignedBox3d box;
+  for (const Vec3& v : design.vertices) box.extend(v);
+  const Vec3 tack(box.max().x(), box.center().y(), box.min().z());
+  for (Vec3& v : design.vertices) v = tack + 1.3 * (v - tack);
+  const ScanScene scene = buildScanScene(record, design);
+  EXPECT_NE(scene.design_mismatch.find("area"), std::string::npos) << scene.design_mismatch;
+}
+
+// A scan of two sails stored with the main's region: the viewer analyses the main
+// (within the noise of its design), where the whole cloud gives the larger gennaker.
+TEST(ScanScene, AStoredRegionKeepsTheAnalysisOnItsSail) {
+  const SailDesign main = exampleDesign(SailType::Main), a2 = exampleDesign(SailType::Gennaker);
+  ScanSimulation sim;
+  sim.noise_sigma_m = test::kSensorSigmaM;
+  sim.points = 15'000;
+  Cloud scan = sampleSail(main, sim);
+  sim.seed = 2;
+  sim.points = 30'000;
+  const Cloud other = sampleSail(a2, sim);
+  scan.points.insert(scan.points.end(), other.points.begin(), other.points.end());
+  scan.viewpoint.reset();  // sampled apart: neither shadows the other
+  const Mesh design = generateSailMesh(main);
+  test::TempDir dir;
+  Database db = openSailDatabase(dir.file("r.sqlite"));
+  addDesignVersion(db, "Main", design, {});
+  ImportMetadata m;
+  m.sail = "Main";
+  m.region = ScanRegion{designRegion(design, plausibleTrimDeviationM(design)), 1};
+  const ScanRecord record = loadScanRecord(db, importScan(db, m, nullptr, &scan).scan_id);
+  const ScanScene scene = buildScanScene(record, design);
+  ASSERT_TRUE(scene.deviation.has_value()) << scene.analysis_error;
+  EXPECT_LT(scene.deviation->rms_m, 3 * test::kSensorSigmaM);
+  EXPECT_EQ(scene.design_mismatch, "");
+  ScanRecord whole = record;
+  whole.region.reset();
+  const ScanScene wrong = buildScanScene(whole, design);
+  ASSERT_TRUE(wrong.deviation.has_value()) << wrong.analysis_error;
+  EXPECT_GT(wrong.deviation->rms_m, plausibleTrimDeviationM(design));
+  EXPECT_NE(wrong.design_mismatch, "");
 }
 
 TEST(ScanScene, WithoutDesignOrCloudItSaysWhatIsMissing) {
