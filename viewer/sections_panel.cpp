@@ -25,6 +25,8 @@ void App::drawSectionTable() {
     const DistanceStats& d = s.deviation.value();
     wrappedText(ImGui::GetStyleColorVec4(ImGuiCol_Text), "Flying − design, signed (+ leeward), " + std::to_string(d.count) + " points");
     wrappedText(kMutedText, deviationSummary(d));
+    // Far from its design beyond any plausible trim: most likely another sail, or the wrong design.
+    if (!s.design_mismatch.empty()) wrappedText(kErrorText, s.design_mismatch);
   } else if (s.design.empty()) {
     ImGui::TextColored(kMutedText, "The sail has no design in the database: flying values only.");
   }

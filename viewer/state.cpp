@@ -89,6 +89,8 @@ nlohmann::json App::state() const {
                            {"max_abs", 1000 * d.max_abs_m}, {"caption", deviationCaption(d)},
                            {"summary", deviationSummary(d)}};
     }
+    // Drawn in red under the deviation in the Sections tab when not empty.
+    j["design_mismatch"] = s.design_mismatch.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.design_mismatch);
     j["sections"] = sectionTable(s);
     j["unmeasured_sections"] = nlohmann::json::array();
     for (const UnmeasuredSection& u : s.sections.unmeasured)

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "analysis/io/mesh_io.hpp"
 #include "database/scan_record.hpp"
 #include "database/schema.hpp"
 #include "tests/cli/run_sailshape.hpp"
@@ -71,6 +72,7 @@ TEST_F(DemoViewer, StateShowsTheMainWithinAFewCentimetresOfItsDesignAndItsStored
   EXPECT_GT(d["p5"].get<double>(), -60.0) << d.dump();
   EXPECT_LT(d["p95"].get<double>(), 60.0) << d.dump();
   EXPECT_GT(d["points"].get<int>(), 1000);
+  EXPECT_TRUE(s["design_mismatch"].is_null()) << "a plausible trim is no mismatch: " << s["design_mismatch"];
 
   // The section table is the stored analysis's, with the design beside it.
   OpenOptions read_only;
@@ -99,6 +101,37 @@ TEST_F(DemoViewer, StateShowsTheMainWithinAFewCentimetresOfItsDesignAndItsStored
   // Every label the browser shows, whole.
   const nlohmann::json& labels = s["browser"]["labels"];
   EXPECT_NE(std::find(labels.begin(), labels.end(), "sailshape demo (emulated wind tunnel)"), labels.end()) << labels;
+}
+
+// A new design version for the main, 1.3 times the size about its tack: the stored main is now a
+// fifth smaller than its current design in every length, beyond any trim (an edge ±10 %, the area ±20 %),
+// and the Sections tab says so in red under the deviation.
+TEST_F(DemoViewer, AMainFarFromItsCurrentDesignIsFlagged) {
+  ASSERT_EQ(demo_.exit_code, 0) << demo_.err;
+  const std::string copy = dir_->file("grown.db");
+  std::filesystem::copy_file(db(), copy, std::filesystem::copy_options::overwrite_existing);
+  const std::string exported = dir_->file("main-design.ply");
+  auto r = sailshape::testing::runSailshape(dir_->file(""), "db design export " + quote(copy) + " --sail 'Demo 36 main' " +
+                                                                quote(exported));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Mesh design = readMesh(exported);
+  Vec3 tack = design.vertices.front();
+  for (const Vec3& v : design.vertices)
+    if (v.z() < tack.z() - 1e-9 || (std::abs(v.z() - tack.z()) < 1e-9 && v.x() > tack.x())) tack = v;
+  for (Vec3& v : design.vertices) v = tack + 1.3 * (v - tack);
+  writeMesh(dir_->file("grown.ply"), design);
+  r = sailshape::testing::runSailshape(dir_->file(""), "db design add " + quote(copy) + " --sail 'Demo 36 main' " +
+                                                           quote(dir_->file("grown.ply")) + " --axes boat --unit m");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string state = dir_->file("grown.json");
+  const ViewerRun v = runViewer(*dir_, quote(copy) + " --screenshot " + quote(dir_->file("grown.png")) + " --state " +
+                                           quote(state) + " --frames 3");
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  std::ifstream in(state);
+  const nlohmann::json s = nlohmann::json::parse(in);
+  ASSERT_EQ(s["scan"]["sail"], "Demo 36 main");
+  ASSERT_TRUE(s["design_mismatch"].is_string()) << s.dump(1);
+  EXPECT_NE(s["design_mismatch"].get<std::string>().find("area"), std::string::npos) << s["design_mismatch"];
 }
 
 // What the JSON cannot tell: the browser's long campaign name and the Sections tab's
