@@ -247,19 +247,6 @@ void checkAnalysisParams(const Cloud& input, const AnalysisParams& p) {
     if (!input.points[i].allFinite())
       throw InvalidInput("[analyzeSail] point " + std::to_string(i) + " has a non-finite coordinate");
   if (auto why = implausibleCoordinates(input.points, "the cloud")) throw InvalidInput("[analyzeSail] " + *why);
-  // Each stage needs its neighbourhood; the largest one in use bounds how few points can be a sail.
-  const std::pair<int, const char*> needs[] = {
-      {p.normals.k_neighbours, "normals.k_neighbours"},
-      {p.segment ? p.region_growing.k_neighbours : 0, "region_growing.k_neighbours"},
-      {p.statistical_outliers ? p.statistical.k_neighbours + 1 : 0, "statistical.k_neighbours"},
-      {p.radius_outliers ? p.radius.min_neighbours + 1 : 0, "radius.min_neighbours"},
-      {p.smooth ? p.smoothing.k_neighbours : 0, "smoothing.k_neighbours"}};
-  const auto most = std::max_element(std::begin(needs), std::end(needs),
-                                     [](const auto& a, const auto& b) { return a.first < b.first; });
-  if (input.size() < static_cast<size_t>(std::max(most->first, 1)))
-    throw InvalidInput("[analyzeSail] the cloud has " + std::to_string(input.size()) +
-                       " points: too few to be a sail's scan (the analysis needs at least " +
-                       std::to_string(most->first) + ", the neighbourhood of " + most->second + ")");
   if (!(p.sensor_sigma_m > 0))
     throw InvalidInput("[analyzeSail] sensor_sigma_m must be > 0 (got " + std::to_string(p.sensor_sigma_m) + ")");
   if (!(p.working_voxel_sigmas >= 0) || !std::isfinite(p.working_voxel_sigmas))
@@ -279,6 +266,20 @@ void checkAnalysisParams(const Cloud& input, const AnalysisParams& p) {
     checkSectionParams(sp);
   }
   if (p.mixed_pixels) checkMixedPixelParams(mixedPixelParams(p));
+  // Each stage needs its neighbourhood; the largest one in use bounds how few points can be a sail.
+  // After the parameters: the neighbourhoods are theirs, and a bad one is the error to report.
+  const std::pair<int, const char*> needs[] = {
+      {p.normals.k_neighbours, "normals.k_neighbours"},
+      {p.segment ? p.region_growing.k_neighbours : 0, "region_growing.k_neighbours"},
+      {p.statistical_outliers ? p.statistical.k_neighbours + 1 : 0, "statistical.k_neighbours"},
+      {p.radius_outliers ? p.radius.min_neighbours + 1 : 0, "radius.min_neighbours"},
+      {p.smooth ? p.smoothing.k_neighbours : 0, "smoothing.k_neighbours"}};
+  const auto most = std::max_element(std::begin(needs), std::end(needs),
+                                     [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (input.size() < static_cast<size_t>(std::max(most->first, 1)))
+    throw InvalidInput("[analyzeSail] the cloud has " + std::to_string(input.size()) +
+                       " points: too few to be a sail's scan (the analysis needs at least " +
+                       std::to_string(most->first) + ", the neighbourhood of " + most->second + ")");
 }
 
 // The segmentation stage: `cloud` becomes the sail cluster, with its fringe, less
