@@ -96,9 +96,13 @@ TEST_F(OwnData, TheReadmesBlockRunsWordForWordAndStoresTheSailOnItsDesign) {
   fs::create_directories(dir_ / "build/cli");
   fs::create_directories(dir_ / "build/viewer");
   fs::create_symlink(SAILSHAPE_BIN, dir_ / "build/cli/sailshape");
-#ifdef SAILSHAPE_VIEWER_BIN
+#if defined(SAILSHAPE_VIEWER_BIN)
   fs::create_symlink(SAILSHAPE_VIEWER_BIN, dir_ / "build/viewer/sailshape-viewer");
+  const bool viewer_built = true;
+#elif defined(SAILSHAPE_SANITIZER_TREE_WITHOUT_VIEWER)
+  const bool viewer_built = false;  // the Release tree's run of this test opens the viewer
 #else
+  const bool viewer_built = false;
   ADD_FAILURE() << "the README's block ends in the viewer, which this build does not have";
 #endif
   for (size_t i = 0; i + 1 < block.size(); ++i)
@@ -125,6 +129,7 @@ TEST_F(OwnData, TheReadmesBlockRunsWordForWordAndStoresTheSailOnItsDesign) {
   ASSERT_EQ(shell("pdftotext my-main.pdf my-main.txt"), 0);
   EXPECT_NE(readText(dir_ / "my-main.txt").find("My main"), std::string::npos);
   // The viewer, as the README opens it, shows the stored scan: its window shot under a private X server.
+  if (!viewer_built) return;
   const std::string viewer = block[6] + " --screenshot shot.png --frames 5";
   ASSERT_EQ(shell("xvfb-run -a -s '-screen 0 1600x1000x24' " + viewer), 0) << readText(dir_ / "err.txt");
   EXPECT_GT(fs::file_size(dir_ / "shot.png"), 10'000u);
