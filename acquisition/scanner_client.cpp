@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cstring>
 #include <deque>
-#include <regex>
 #include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -436,7 +435,8 @@ ScanBatch ScannerClient::receiveScans(size_t max_scans, double max_seconds) {
     const ReadResult r = m.readSome(deadline);
     if (r == ReadResult::kClosed) {
       batch.connection_lost = true;
-      batch.message = "connection to " + m.where + " lost after " + std::to_string(batch.scans.size()) + " scans";
+      // The scans the client received in all (a batch of one, nextScan's, would count none).
+      batch.message = "connection to " + m.where + " lost after " + std::to_string(m.stats.scans) + " scans";
       if (m.incomplete_bytes_at_close > 0)
         batch.message += " (an incomplete frame of " + std::to_string(m.incomplete_bytes_at_close) + " bytes was discarded)";
       break;
@@ -453,11 +453,7 @@ ScanBatch ScannerClient::receiveScans(size_t max_scans, double max_seconds) {
 ScanData ScannerClient::nextScan() {
   ScanBatch b = receiveScans(1, params_.scan_timeout_s);
   if (b.scans.empty()) {
-    // The batch of one counts none; the user wants the scans this connection brought.
-    if (b.connection_lost)
-      throw ScannerError("[ScannerClient::nextScan] " +
-                         std::regex_replace(b.message, std::regex("lost after 0 scans"),
-                                            "lost after " + std::to_string(impl_->stats.scans) + " scans"));
+    if (b.connection_lost) throw ScannerError("[ScannerClient::nextScan] " + b.message);
     throw ScannerError("[ScannerClient::nextScan] no scan from " + impl_->where + " within " + seconds(params_.scan_timeout_s));
   }
   return std::move(b.scans.front());

@@ -23,7 +23,7 @@ void addScannerCommand(CLI::App& app);
 void addCropCommand(CLI::App& app);
 
 // --unit and --axes of a command that reads a design file (DesignImportOptions' two fields).
-void addDesignFrameOptions(CLI::App* cmd, std::string& unit, std::string& axes);
+void addDesignFileOptions(CLI::App* cmd, std::string& unit, std::string& axes);
 
 // The global --verbose flag; add it before the subcommands, which inherit it.
 void addVerboseFlag(CLI::App& app);

@@ -195,17 +195,6 @@ void run(const CompareOptions& o) {
 
 }  // namespace
 
-void addDesignFrameOptions(CLI::App* cmd, std::string& unit, std::string& axes) {
-  cmd->add_option("--unit", unit, "Design file unit: auto (mm when the largest extent exceeds 100), m, mm or cm")
-      ->check(CLI::IsMember({"auto", "m", "mm", "cm"}))
-      ->capture_default_str();
-  cmd->add_option("--axes", axes,
-                  "Design file frame: auto (sailcut for DXF and Y-up meshes, else boat), boat or sailcut (X tack to "
-                  "clew, Y up, Z depth)")
-      ->check(CLI::IsMember({"auto", "boat", "sailcut"}))
-      ->capture_default_str();
-}
-
 void addCompareCommand(CLI::App& app) {
   auto opt = std::make_shared<CompareOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -227,7 +216,7 @@ void addCompareCommand(CLI::App& app) {
   cmd->add_option("--distances", opt->distances_out,
                   "Write the flying points with their signed distance in mm as the intensity field (.ply, .pcd, "
                   ".xyz, .csv): the colour map");
-  addDesignFrameOptions(cmd, opt->unit, opt->axes);
+  addDesignFileOptions(cmd, opt->unit, opt->axes);
   cmd->add_option("--params", opt->params_file, "Pipeline parameters file for a flying cloud (see analyze "
                                                 "--print-params)");
   cmd->add_flag("--no-segment", opt->no_segment, "The flying cloud is the sail alone: skip segmentation");

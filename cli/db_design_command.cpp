@@ -6,6 +6,7 @@
 #include "analysis/core/errors.hpp"
 #include "analysis/io/mesh_io.hpp"
 #include "cli/db_design_command.hpp"
+#include "cli/commands.hpp"
 #include "cli/sail_design.hpp"
 #include "database/catalog.hpp"
 

@@ -137,7 +137,7 @@ void addFitCommand(CLI::App& app) {
   cmd->add_option("--json", opt->json_out,
                   "Write coverage, RMS, strain statistics, warnings and the per-vertex displacement, support "
                   "distance and σ as JSON to this file");
-  addDesignFrameOptions(cmd, opt->unit, opt->axes);
+  addDesignFileOptions(cmd, opt->unit, opt->axes);
   cmd->add_option("--noise-mm", opt->noise_mm, "The scanner's range noise σ in mm (SPEC: 4 mm; up to 3.5× that in "
                                                "direct sunlight)")
       ->check(CLI::Range(0.1, 100.0))

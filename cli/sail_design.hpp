@@ -25,9 +25,6 @@ struct DesignFile {
 DesignFile readDesignFile(const std::string& path, const std::string& unit = "auto", const std::string& axes = "auto",
                           const SectionParams& sections = {});
 
-// --unit and --axes of a command that reads a design file (DesignImportOptions).
-void addDesignFileOptions(CLI::App* cmd, std::string& unit, std::string& axes);
-
 // `design show`'s table (or JSON to json_out) of a design: what the importer
 // applied, corners, edge lengths, area and sections; `input` names it.
 void printDesignReport(const std::string& input, const DesignImport& design, const MeshSections& sections,
