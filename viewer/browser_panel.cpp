@@ -56,9 +56,14 @@ void App::drawBrowser(float x, float y, float w, float h) {
               }
               if (ImGui::IsItemHovered()) ImGui::SetTooltip("overlay this trim step on the selected scan");
               ImGui::SameLine();
-              const std::string label = "scan " + std::to_string(scan.scan_id) + "  " +
-                                        (scan.point_count ? std::to_string(scan.point_count) + " pts" : std::string());
-              if (ImGui::Selectable(label.c_str(), browser_.selected_scan == scan.scan_id)) selectScan(scan.scan_id);
+              // The point count when the tree has room for it, else in the tooltip.
+              const std::string name = "scan " + std::to_string(scan.scan_id);
+              const std::string points = scan.point_count ? std::to_string(scan.point_count) + " pts" : std::string();
+              const std::string full = points.empty() ? name : name + "  " + points;
+              const bool fits = ImGui::CalcTextSize(full.c_str()).x <= ImGui::GetContentRegionAvail().x;
+              if (ImGui::Selectable(fits ? full.c_str() : name.c_str(), browser_.selected_scan == scan.scan_id))
+                selectScan(scan.scan_id);
+              if (!fits && !points.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", points.c_str());
               ImGui::PopID();
             }
             ImGui::TreePop();
@@ -79,22 +84,24 @@ void App::drawDisplayOptions() {
   ImGui::TextColored(kAccentText, "Display");
   ViewOptions& o = view_.options;
   bool changed = false;
-  changed |= ImGui::Checkbox("design (blue wireframe)", &o.design);
+  // The colour key where the panel has room for it.
+  const bool key = checkboxWidth("design (blue wireframe)") <= ImGui::GetContentRegionAvail().x;
+  changed |= ImGui::Checkbox(key ? "design (blue wireframe)###design" : "design###design", &o.design);
   changed |= ImGui::Checkbox("flying surface", &o.surface);
-  ImGui::SameLine();
+  sameLineIfFits(checkboxWidth("raw cloud"));
   changed |= ImGui::Checkbox("raw cloud", &o.cloud);
   changed |= ImGui::Checkbox("sail cluster", &o.cluster);
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("the points segmentation took for the sail, cleaned and smoothed");
   changed |= ImGui::Checkbox("sections", &o.sections);
-  ImGui::SameLine();
+  sameLineIfFits(checkboxWidth("design sections"));
   changed |= ImGui::Checkbox("design sections", &o.design_sections);
   changed |= ImGui::Checkbox("section planes", &o.section_planes);
   changed |= ImGui::Checkbox("deviation colours", &o.deviation);
   if (o.deviation) {
-    ImGui::SetNextItemWidth(140);
+    ImGui::SetNextItemWidth(widthBesideLabel("± mm", 140));
     changed |= ImGui::SliderFloat("± mm", &o.deviation_range_mm, 0.0f, 300.0f, o.deviation_range_mm > 0 ? "%.0f" : "auto");
   }
-  ImGui::SetNextItemWidth(140);
+  ImGui::SetNextItemWidth(widthBesideLabel("point size", 140));
   changed |= ImGui::SliderFloat("point size", &o.point_size, 1.0f, 6.0f, "%.0f");
   if (changed) view_.rebuild = true;
 }

@@ -43,7 +43,7 @@ void App::drawSectionTable() {
     ImGui::TextColored(kAccentText, "Section %zu   f = %.2f   z = %.2f m", i + 1, r.fraction, r.height_m);
     const ImGuiTableFlags flags = ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV | ImGuiTableFlags_SizingStretchSame;
     if (ImGui::BeginTable(("sec" + std::to_string(i)).c_str(), 5, flags)) {
-      ImGui::TableSetupColumn("");
+      ImGui::TableSetupColumn("", ImGuiTableColumnFlags_WidthFixed);  // the names whole; the numbers share the rest
       ImGui::TableSetupColumn("design");
       ImGui::TableSetupColumn("flying");
       ImGui::TableSetupColumn("Δ");

@@ -1,7 +1,7 @@
 // `--state FILE`: what the panels show, as JSON, so tests (and scripts) read the
 // numbers a person reads: the scan in the 3D view and its captions, the design
 // against flying statistics in millimetres, the Sections tab's table, the
-// browser's labels and the messages. Values are SI in the JSON's own units (keys
+// browser's labels, the messages, and any panel whose content runs past its edge. Values are SI in the JSON's own units (keys
 // end in _mm, _m, _pct, _deg); null where the panel shows "—".
 #include <cmath>
 
@@ -105,6 +105,10 @@ nlohmann::json App::state() const {
   const LiveStatus live = live_.mode.status();
   j["live"] = {{"running", live.running}, {"swept", live.swept}, {"analysed", live.analysed}, {"failed", live.failed}};
   j["messages"] = log_.lines;
+  // The last frame's windows whose items reach past their right edge (px): text cut off
+  // at a panel's edge, which the screenshot shows and no other key tells.
+  j["overflow_px"] = nlohmann::json::object();
+  for (const auto& [window, px] : overflowingWindows()) j["overflow_px"][window] = px;
   return j;
 }
 

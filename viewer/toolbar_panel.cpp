@@ -13,11 +13,25 @@ namespace sailshape::viewer {
 void App::drawToolbar(float x, float y, float w, float h) {
   ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(8, 6));
   if (beginPanel("##toolbar", x, y, w, h, ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar)) {
+    // The path field takes what the buttons leave, up to 28 % of the window; in a narrow
+    // window the subtitle goes first, then the field shrinks to 120 px.
+    const ImGuiStyle& st = ImGui::GetStyle();
+    const auto button = [&](const char* label) { return ImGui::CalcTextSize(label).x + 2 * st.FramePadding.x; };
+    float buttons = st.ItemSpacing.x + button("Open") + 24 + ImGui::CalcTextSize("Camera").x;
+    for (const char* label : {"3/4", "Side", "Top", "Astern", "Bow", "Unit"}) buttons += st.ItemSpacing.x + button(label);
+    buttons += 24 + std::max(button("Report (PDF)"), button("Writing report…"));
+    const float end = w - st.WindowPadding.x;
+    const bool subtitle = end - 200 - buttons >= 120;
     ImGui::TextColored(kAccentText, "sailshape");
-    ImGui::SameLine();
-    ImGui::TextColored(kMutedText, "design vs flying");
-    ImGui::SameLine(200);
-    ImGui::SetNextItemWidth(std::max(120.0f, w * 0.28f));
+    if (subtitle) {
+      ImGui::SameLine();
+      ImGui::TextColored(kMutedText, "design vs flying");
+      ImGui::SameLine(200);
+    } else {
+      ImGui::SameLine();
+    }
+    const float field = end - (ImGui::GetCursorPosX() + buttons);
+    ImGui::SetNextItemWidth(std::clamp(field, 120.0f, std::max(120.0f, w * 0.28f)));
     const bool enter = ImGui::InputTextWithHint("##dbpath", "database file (.sqlite)", database_.path_input,
                                                 sizeof database_.path_input, ImGuiInputTextFlags_EnterReturnsTrue);
     ImGui::SameLine();

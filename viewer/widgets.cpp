@@ -1,5 +1,7 @@
 #include "viewer/widgets.hpp"
 
+#include <imgui_internal.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cfloat>
@@ -71,6 +73,36 @@ float wrappedCaption(ImDrawList* dl, ImVec2 at, ImU32 colour, const std::string&
   const float size = ImGui::GetFontSize();
   dl->AddText(font, size, at, colour, text.c_str(), nullptr, width);
   return font->CalcTextSizeA(size, FLT_MAX, width, text.c_str()).y;
+}
+
+void sameLineIfFits(float width) {
+  const float right = ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x + width;
+  if (right <= ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) ImGui::SameLine();
+}
+
+float checkboxWidth(const char* label) {
+  return ImGui::GetFrameHeight() + ImGui::GetStyle().ItemInnerSpacing.x + ImGui::CalcTextSize(label, nullptr, true).x;
+}
+
+float widthBesideLabel(const char* label, float preferred) {
+  const float room = ImGui::GetContentRegionAvail().x - ImGui::GetStyle().ItemInnerSpacing.x -
+                     ImGui::CalcTextSize(label, nullptr, true).x;
+  return std::max(1.0f, std::min(preferred, room));
+}
+
+std::map<std::string, float> overflowingWindows() {
+  std::map<std::string, float> out;
+  const ImGuiContext* g = ImGui::GetCurrentContext();
+  if (!g) return out;
+  for (const ImGuiWindow* w : g->Windows) {
+    if (!w->Active || w->Hidden || w->Collapsed) continue;
+    // CursorMaxPos is the furthest any item of this frame reached (px, screen space);
+    // WorkRect is where items may go, inside the padding and any scrollbar. Half a pixel
+    // absorbs the rounding of glyph advances.
+    const float past = w->DC.CursorMaxPos.x - w->WorkRect.Max.x;
+    if (past > 0.5f) out[w->Name] = past;
+  }
+  return out;
 }
 
 void helpMarker(const char* text) {

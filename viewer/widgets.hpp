@@ -4,6 +4,7 @@
 // Dear ImGui stays in the viewer's .cpp files and this header.
 #include <imgui.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,21 @@ void wrappedText(const ImVec4& colour, const std::string& text);
 void elidedText(const ImVec4& colour, const std::string& text, float width);
 // `text` drawn into `dl` at `at`, wrapped at `width` pixels; returns its height.
 float wrappedCaption(ImDrawList* dl, ImVec2 at, ImU32 colour, const std::string& text, float width);
+
+// The windows of the frame just built whose items reach past their content
+// region's right edge, by how many pixels: text that neither wraps nor fits, cut off
+// at the panel's edge. Keys are ImGui's window names (a child is "Parent/child_…").
+// Call between the frame's last End() and the next NewFrame().
+std::map<std::string, float> overflowingWindows();
+
+// Puts the next item (`width` px) beside the last one when it still fits inside the
+// panel, else on a line of its own: pairs of options stay whole in a narrow window.
+void sameLineIfFits(float width);
+// The width of a checkbox with `label` (px), for sameLineIfFits.
+float checkboxWidth(const char* label);
+// The width to give a widget whose `label` is drawn on its right (a slider): `preferred`
+// px, less when the panel has not room for both.
+float widthBesideLabel(const char* label, float preferred);
 
 // A "(?)" after the last item that shows `text` when hovered.
 void helpMarker(const char* text);

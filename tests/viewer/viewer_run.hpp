@@ -36,15 +36,15 @@ inline std::string quote(const std::string& s) {
   return q + "'";
 }
 
-inline ViewerRun runViewer(const test::TempDir& dir, const std::string& args) {
+inline ViewerRun runViewer(const test::TempDir& dir, const std::string& args, int width = kWidth, int height = kHeight) {
   std::string launcher;
   if (std::system("command -v xvfb-run >/dev/null 2>&1") == 0)
     launcher = "xvfb-run -a -s '-screen 0 1920x1200x24' ";  // a private server even when DISPLAY is set
   else if (!std::getenv("DISPLAY"))
     ADD_FAILURE() << "neither xvfb-run nor a DISPLAY: install xvfb (scripts/setup)";
   const std::string out = dir.file("stdout.txt"), err = dir.file("stderr.txt");
-  const std::string cmd = launcher + quote(SAILSHAPE_VIEWER_BIN) + " " + args + " --width " + std::to_string(kWidth) +
-                          " --height " + std::to_string(kHeight) + " </dev/null >" + quote(out) + " 2>" + quote(err);
+  const std::string cmd = launcher + quote(SAILSHAPE_VIEWER_BIN) + " " + args + " --width " + std::to_string(width) +
+                          " --height " + std::to_string(height) + " </dev/null >" + quote(out) + " 2>" + quote(err);
   const int status = std::system(cmd.c_str());
   ViewerRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
