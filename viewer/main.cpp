@@ -330,7 +330,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"3/4", "side", "top", "astern", "bow", "unit"}));
   cli.add_option("--state", o.state,
                  "with --screenshot: also write what the panels show as JSON to this file (the scan shown and its "
-                 "captions, design-vs-flying statistics in mm, the section table, the browser's labels, messages, and overflow_px: any panel whose content runs past its right edge)");
+                 "captions, design-vs-flying statistics in mm, the section table, the browser's labels, messages, and "
+                 "overflow_px: any panel whose content runs past its right edge)");
   cli.add_flag("--deviation", o.deviation, "start with the flying shape coloured by signed deviation from the design");
   try {
     cli.parse(argc, argv);
