@@ -202,20 +202,34 @@ double robustScale(const std::vector<Foot>& feet, const std::vector<char>* use) 
 // Per-vertex σ. A supported vertex's position is, through the data term, a weighted mean of
 // the samples on its triangles (their barycentric weights summing to n_eff): σ = noise/√n_eff,
 // never more than the noise itself. Beyond the samples the fit continues the supported
-// surface's position and slope; what no sample says there is how the curvature changed, and
-// a curvature off by Δκ (the prior) deflects a surface continued over a distance d by ½·Δκ·d².
-// The two add in quadrature.
-std::vector<double> vertexSigmas(const Mesh& m, const std::vector<Foot>& feet, const std::vector<char>& use,
+// surface, and what no sample says there is how the surface turns and bends: its slope
+// relative to the design's may change by as much as it changed where the samples are (g,
+// the RMS angle between the fitted and the design's normals over the supported vertices),
+// which moves a surface continued over a distance d by g·d; and its curvature may be off by
+// Δκ (the prior), which deflects it by ½·Δκ·d². The three add in quadrature.
+std::vector<double> vertexSigmas(const Mesh& m, const Mesh& design, const std::vector<Foot>& feet,
+                                 const std::vector<char>& use, const std::vector<char>& supported,
                                  const std::vector<double>& support_distance, double noise, double dkappa) {
   std::vector<double> n_eff(m.vertices.size(), 0.0);
   for (size_t s = 0; s < feet.size(); ++s)
     if (use[s])
       for (int k = 0; k < 3; ++k) n_eff[m.triangles[static_cast<size_t>(feet[s].triangle)][k]] += feet[s].bary[k];
+  const std::vector<Vec3> fitted_normal = vertexNormals(m), design_normal = vertexNormals(design);
+  double turn2 = 0;
+  size_t turned = 0;
+  for (size_t v = 0; v < m.vertices.size(); ++v)
+    if (supported[v]) {
+      const double c = std::clamp(std::abs(fitted_normal[v].dot(design_normal[v])), -1.0, 1.0);
+      turn2 += std::pow(std::acos(c), 2);
+      ++turned;
+    }
+  const double g = turned ? std::sqrt(turn2 / static_cast<double>(turned)) : 0.0;
   std::vector<double> sigma(m.vertices.size());
   for (size_t v = 0; v < sigma.size(); ++v) {
-    const double d = support_distance[v];
+    const double d = supported[v] ? 0.0 : support_distance[v];
+    const double turned_by = g * d;
     const double continued = 0.5 * dkappa * d * d;
-    sigma[v] = std::sqrt(noise * noise / std::max(1.0, n_eff[v]) + continued * continued);
+    sigma[v] = std::sqrt(noise * noise / std::max(1.0, n_eff[v]) + turned_by * turned_by + continued * continued);
   }
   return sigma;
 }
@@ -330,8 +344,8 @@ DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const 
   out.displacement_m.resize(x.size());
   for (size_t v = 0; v < x.size(); ++v) out.displacement_m[v] = x[v] - design.vertices[v];
   const double mean_chord = total_area / std::max(1e-9, diagonal(design.vertices));
-  out.sigma_m = vertexSigmas(out.fitted, feet, use, out.support_distance_m, std::max(out.noise_m, 1e-6),
-                             8.0 * p.camber_change_prior / mean_chord);
+  out.sigma_m = vertexSigmas(out.fitted, aligned, feet, use, out.supported, out.support_distance_m,
+                             std::max(out.noise_m, 1e-6), 8.0 * p.camber_change_prior / mean_chord);
   strainAndWarnings(design, top, p, out);
   if (out.samples_used < samples.size() / 2)
     out.warnings.push_back("only " + std::to_string(out.samples_used) + " of " + std::to_string(samples.size()) +
