@@ -1,8 +1,9 @@
 // `--state FILE`: what the panels show, as JSON, so tests (and scripts) read the
 // numbers a person reads: the scan in the 3D view and its captions, the design
 // against flying statistics in millimetres, the Sections tab's table, the
-// browser's labels, the messages, and any panel whose content runs past its edge. Values are SI in the JSON's own units (keys
-// end in _mm, _m, _pct, _deg); null where the panel shows "—".
+// browser's labels, the messages, and any panel whose content runs past its edge.
+// Values are SI in the JSON's own units (keys end in _mm, _m, _pct, _deg); null
+// where the panel shows "—".
 #include <cmath>
 
 #include "viewer/app.hpp"

@@ -13,22 +13,22 @@ namespace sailshape::viewer {
 void App::drawToolbar(float x, float y, float w, float h) {
   ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(8, 6));
   if (beginPanel("##toolbar", x, y, w, h, ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar)) {
-    // The path field takes what the buttons leave, up to 28 % of the window; in a narrow
-    // window the subtitle goes first, then the field shrinks to 120 px.
+    constexpr float kGroupGap = 24;  // px between the path, camera and report groups
+    const std::pair<const char*, CameraPreset> presets[] = {
+        {"3/4", CameraPreset::ThreeQuarter}, {"Side", CameraPreset::Side}, {"Top", CameraPreset::Top}, {"Astern", CameraPreset::Astern}, {"Bow", CameraPreset::Bow}};
+    // The path field takes what the buttons after it leave, up to 28 % of the window; in a
+    // narrow window the subtitle goes first, then the field shrinks to 120 px.
     const ImGuiStyle& st = ImGui::GetStyle();
     const auto button = [&](const char* label) { return ImGui::CalcTextSize(label).x + 2 * st.FramePadding.x; };
-    float buttons = st.ItemSpacing.x + button("Open") + 24 + ImGui::CalcTextSize("Camera").x;
-    for (const char* label : {"3/4", "Side", "Top", "Astern", "Bow", "Unit"}) buttons += st.ItemSpacing.x + button(label);
-    buttons += 24 + std::max(button("Report (PDF)"), button("Writing report…"));
+    float buttons = st.ItemSpacing.x + button("Open") + kGroupGap + ImGui::CalcTextSize("Camera").x;
+    for (const auto& [label, preset] : presets) buttons += st.ItemSpacing.x + button(label);
+    buttons += st.ItemSpacing.x + button("Unit") + kGroupGap + std::max(button("Report (PDF)"), button("Writing report…"));
     const float end = w - st.WindowPadding.x;
-    const bool subtitle = end - 200 - buttons >= 120;
     ImGui::TextColored(kAccentText, "sailshape");
-    if (subtitle) {
-      ImGui::SameLine();
+    ImGui::SameLine();
+    if (end - 200 - buttons >= 120) {
       ImGui::TextColored(kMutedText, "design vs flying");
       ImGui::SameLine(200);
-    } else {
-      ImGui::SameLine();
     }
     const float field = end - (ImGui::GetCursorPosX() + buttons);
     ImGui::SetNextItemWidth(std::clamp(field, 120.0f, std::max(120.0f, w * 0.28f)));
@@ -36,10 +36,8 @@ void App::drawToolbar(float x, float y, float w, float h) {
                                                 sizeof database_.path_input, ImGuiInputTextFlags_EnterReturnsTrue);
     ImGui::SameLine();
     if (ImGui::Button("Open") || enter) openDatabase(database_.path_input);
-    ImGui::SameLine(0, 24);
+    ImGui::SameLine(0, kGroupGap);
     ImGui::TextColored(kMutedText, "Camera");
-    const std::pair<const char*, CameraPreset> presets[] = {
-        {"3/4", CameraPreset::ThreeQuarter}, {"Side", CameraPreset::Side}, {"Top", CameraPreset::Top}, {"Astern", CameraPreset::Astern}, {"Bow", CameraPreset::Bow}};
     for (const auto& [label, preset] : presets) {
       ImGui::SameLine();
       if (ImGui::Button(label)) view_.camera = preset;
@@ -55,7 +53,7 @@ void App::drawToolbar(float x, float y, float w, float h) {
                                     "looking along its sweep's centre"
                                   : "from the first scanner unit (Scanners tab): at its scanner, looking along its "
                                     "sweep's centre");
-    ImGui::SameLine(0, 24);
+    ImGui::SameLine(0, kGroupGap);
     // A live sweep that was not stored has no scan to report on.
     ImGui::BeginDisabled(!load_.scene || load_.scene->record.scan_id == 0 || report_.task.busy());
     if (ImGui::Button(report_.task.busy() ? "Writing report…" : "Report (PDF)")) {

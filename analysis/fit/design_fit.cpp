@@ -219,7 +219,8 @@ std::vector<double> vertexSigmas(const Mesh& m, const Mesh& design, const std::v
   size_t turned = 0;
   for (size_t v = 0; v < m.vertices.size(); ++v)
     if (supported[v]) {
-      const double c = std::clamp(std::abs(fitted_normal[v].dot(design_normal[v])), -1.0, 1.0);
+      // Unsigned: a mesh's normals may face either way.
+      const double c = std::min(1.0, std::abs(fitted_normal[v].dot(design_normal[v])));
       turn2 += std::pow(std::acos(c), 2);
       ++turned;
     }
