@@ -13,6 +13,7 @@
 #include "analysis/io/cloud_io.hpp"
 #include "analysis/io/mesh_io.hpp"
 #include "analysis/pipeline/analysis_json.hpp"
+#include "analysis/pipeline/design_prior.hpp"
 #include "analysis/pipeline/params_io.hpp"
 #include "analysis/pipeline/pipeline.hpp"
 #include "analysis/pipeline/sail_region.hpp"
@@ -29,7 +30,7 @@ struct AnalyzeOptions {
   int sections = 0;
   std::vector<double> at;
   std::string plane;
-  std::string json_out, mesh_out, params_file, cloud_out;
+  std::string json_out, mesh_out, params_file, cloud_out, fitted_out;
   bool print_params = false, describe_params = false, no_segment = false, quiet = false, sky = false;
   int corners = -1;
   std::string scanner;  // lms111 / lms511: its beam footprint for the edges
@@ -46,32 +47,41 @@ void printTable(const SailAnalysis& a) {
               a.mesh.triangles.size(), o.area_m2, u.area_m2);
   if (a.working_voxel_m > 0)
     std::printf("  analysed as %zu points, one per %.1f cm column of the sail (working_voxel_sigmas)\n", a.working_points, 100 * a.working_voxel_m);
-  auto corner = [](const char* name, const Vec3& p, double sigma_m) {
-    std::printf("  %-5s (%8.3f, %8.3f, %8.3f) m ± %.1f cm\n", name, p.x(), p.y(), p.z(), 100 * sigma_m);
+  // With the design fitted in, a corner the scan did not reach is the fitted design's.
+  const bool fitted = a.design_fit.has_value();
+  auto corner = [fitted](const char* name, const Vec3& p, double sigma_m, bool reached) {
+    std::printf("  %-5s (%8.3f, %8.3f, %8.3f) m ± %.1f cm%s\n", name, p.x(), p.y(), p.z(), 100 * sigma_m,
+                fitted && !reached ? "  (not scanned: the fitted design's)" : "");
   };
-  corner("tack", o.tack, u.tack_m);
-  corner("clew", o.clew, u.clew_m);
-  corner("head", o.head, u.head_m);
-  if (o.has_peak) corner("peak", o.peak, u.peak_m);
+  const SailOutline::Coverage& cov = o.coverage;
+  corner("tack", o.tack, u.tack_m, cov.known && cov.tack);
+  corner("clew", o.clew, u.clew_m, cov.known && cov.clew);
+  corner("head", o.head, u.head_m, cov.known && cov.head);
+  if (o.has_peak) corner("peak", o.peak, u.peak_m, cov.known && cov.peak);
   std::printf("  luff %.3f ± %.3f m, leech %.3f ± %.3f m, foot %.3f ± %.3f m", o.luff_length_m, u.luff_length_m,
               o.leech_length_m, u.leech_length_m, o.foot_length_m, u.foot_length_m);
   if (o.has_peak) std::printf(", top %.3f ± %.3f m", o.top_length_m, u.top_length_m);
   if (o.footprint_reach_m > 0)
     std::printf("\n  edges moved out by the beam's footprint, %.1f cm along luff and leech", 100 * o.footprint_reach_m);
-  const SailOutline::Coverage& cov = o.coverage;
-  if (cov.known) {
+  if (cov.known && !fitted) {
     std::printf("\n  scanned to the sail's edge along %.0f %% of the luff, %.0f %% of the leech, %.0f %% of the foot",
                 100 * cov.luff, 100 * cov.leech, 100 * cov.foot);
     if (o.has_peak) std::printf(", %.0f %% of the top", 100 * cov.top);
-  } else {
+  } else if (!fitted) {
     std::printf("\n  where the scan reached the sail's edges is not known: no scanner position (--viewpoint)");
   }
   const LuffCurve& l = a.luff;
   std::printf("\n  luff curve: LUFA sag %.1f ± %.1f mm at %.0f ± %.0f %%, LUSW sag %.1f ± %.1f mm at %.0f ± %.0f %%\n\n",
               1000 * l.lufa_sag_m, 1000 * l.uncertainty.lufa_sag_m, l.lufa_position_pct, l.uncertainty.lufa_position_pct,
               1000 * l.lusw_sag_m, 1000 * l.uncertainty.lusw_sag_m, l.lusw_position_pct, l.uncertainty.lusw_position_pct);
-  std::printf("%8s %9s %14s %14s %14s %14s %13s %13s\n", "height", "chord m", "camber %", "draft %", "twist deg",
-              "twist rel", "entry deg", "exit deg");
+  if (fitted) {
+    const DesignFit& f = *a.design_fit;
+    std::printf("  design fitted to the scan: %.0f %% of its area within %.0f mm of a sample, RMS to them %.1f mm; "
+                "the scan alone: %s\n",
+                100 * f.coverage, 1000 * f.support_radius_m, 1000 * f.rms_m, a.inferred_because.c_str());
+  }
+  std::printf("%8s %9s %14s %14s %14s %14s %13s %13s%s\n", "height", "chord m", "camber %", "draft %", "twist deg",
+              "twist rel", "entry deg", "exit deg", fitted ? "  inferred" : "");
   // Measured and unmeasured sections in height order.
   const auto& measured = a.sections.sections;
   const auto& unmeasured = a.sections.unmeasured;
@@ -92,10 +102,12 @@ void printTable(const SailAnalysis& a) {
         return std::string(width - 9, ' ') + "—" + std::string(8, ' ');  // "—" is one column, three bytes
       return std::string(buf);
     };
-    std::printf("%7.0f%% %9.3f %s %s %s %s %s %s\n", 100 * s.fraction, v.chord_m,
+    std::printf("%7.0f%% %9.3f %s %s %s %s %s %s", 100 * s.fraction, v.chord_m,
                 cell(v.camber_pct, u.camber_pct, 14, 2).c_str(), cell(v.draft_pct, u.draft_pct, 14, 1).c_str(),
                 cell(v.twist_deg, u.twist_deg, 14, 2).c_str(), cell(v.twist_rel_deg, u.twist_rel_deg, 14, 2).c_str(),
                 cell(v.entry_deg, u.entry_deg, 13, 1).c_str(), cell(v.exit_deg, u.exit_deg, 13, 1).c_str());
+    if (fitted) std::printf("  %7.0f %%", s.inferred_pct);
+    std::printf("\n");
   }
   if (!a.warnings.empty()) {
     std::printf("\nWarnings:\n");
@@ -139,11 +151,16 @@ void run(const AnalyzeOptions& o) {
   } else if (o.margin_given) {
     throw InvalidInput("analyze: --margin applies with --design only");
   }
-  SailAnalysis a = design ? analyzeInRegion(read.cloud, region, design->design.mesh, params, bar.progress())
+  if (!o.fitted_out.empty() && !design) throw InvalidInput("analyze: --fitted applies with --design only");
+  SailAnalysis a = design ? analyzeWithDesign(read.cloud, region, design->design.mesh, design->sections, params, bar.progress())
                           : analyzeSail(read.cloud, params, bar.progress());
   bar.finish();
   if (design) check = checkAgainstDesign(design->design.mesh, design->sections, a);
   if (!o.mesh_out.empty()) writeMesh(o.mesh_out, a.mesh);
+  if (!o.fitted_out.empty()) {
+    if (!a.design_fit) throw AnalysisError("analyze: --fitted: the scan gave the sections alone, no design was fitted");
+    writeMesh(o.fitted_out, a.design_fit->fitted);
+  }
   if (!o.cloud_out.empty()) writeCloud(o.cloud_out, a.sail_cloud);
   if (!o.json_out.empty()) {
     nlohmann::json doc = analysisToJson(a);
@@ -156,6 +173,16 @@ void run(const AnalyzeOptions& o) {
                        {"deviation_mean_m", st.mean_m},
                        {"deviation_rms_m", st.rms_m},
                        {"mismatch", check->mismatch}};
+      // Whether the design stood in for what the scan did not reach, and how well it fits.
+      if (a.design_fit) {
+        const DesignFit& f = *a.design_fit;
+        doc["design"]["fit"] = {{"because", a.inferred_because}, {"coverage", f.coverage},
+                                {"support_radius_m", f.support_radius_m}, {"rms_m", f.rms_m},
+                                {"noise_m", f.noise_m}, {"samples", f.samples}, {"samples_used", f.samples_used},
+                                {"warnings", f.warnings}};
+      } else {
+        doc["design"]["fit"] = nullptr;
+      }
     }
     writeJsonFile(o.json_out, doc);
     if (!o.quiet) std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());
@@ -220,7 +247,14 @@ void addAnalyzeCommand(CLI::App& app) {
                   "The sail's design (.dxf, .obj, .stl, .ply, as `design show` reads): the scan (a whole tunnel or "
                   "deck) is cropped to the design's box grown by --margin, segmentation takes the cluster that lies "
                   "nearest the design, and a sail that flies farther from it than any plausible trim (RMS deviation "
-                  "beyond a fifth of the mean chord, area beyond ±20 %, an edge beyond ±10 %) is a warning");
+                  "beyond a fifth of the mean chord, area beyond ±20 %, an edge beyond ±10 %) is a warning. When the scan "
+                  "alone gives no sections (it did not reach the head or a clew: out of range, at grazing angles), "
+                  "the design is fitted onto the sail's samples (as `sailshape fit`): the corners the scan did not "
+                  "reach are the fitted design's, the sections are cut on the fitted surface, and each section says "
+                  "how much of it was inferred, its σ carrying the fit's");
+  cmd->add_option("--fitted", opt->fitted_out,
+                  "With --design, when the design was fitted in: write the fitted design (.ply, .obj or .stl), its "
+                  "vertices and triangles in the design's order");
   auto* margin = cmd->add_option("--margin", opt->margin,
                                  "With --design: metres added to every side of its box (default: a fifth of the "
                                  "design's mean chord, as far as a plausible trim moves the sail)");

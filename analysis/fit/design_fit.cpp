@@ -209,7 +209,8 @@ double robustScale(const std::vector<Foot>& feet, const std::vector<char>* use) 
 // Δκ (the prior), which deflects it by ½·Δκ·d². The three add in quadrature.
 std::vector<double> vertexSigmas(const Mesh& m, const Mesh& design, const std::vector<Foot>& feet,
                                  const std::vector<char>& use, const std::vector<char>& supported,
-                                 const std::vector<double>& support_distance, double noise, double dkappa) {
+                                 const std::vector<double>& support_distance, double noise, double dkappa,
+                                 std::vector<double>& slope_sigma, double& turn) {
   std::vector<double> n_eff(m.vertices.size(), 0.0);
   for (size_t s = 0; s < feet.size(); ++s)
     if (use[s])
@@ -225,12 +226,16 @@ std::vector<double> vertexSigmas(const Mesh& m, const Mesh& design, const std::v
       ++turned;
     }
   const double g = turned ? std::sqrt(turn2 / static_cast<double>(turned)) : 0.0;
+  turn = g;
   std::vector<double> sigma(m.vertices.size());
+  slope_sigma.assign(m.vertices.size(), 0.0);
   for (size_t v = 0; v < sigma.size(); ++v) {
     const double d = supported[v] ? 0.0 : support_distance[v];
     const double turned_by = g * d;
     const double continued = 0.5 * dkappa * d * d;
     sigma[v] = std::sqrt(noise * noise / std::max(1.0, n_eff[v]) + turned_by * turned_by + continued * continued);
+    // The slope's σ is the two terms' rate along d: the turn g and the curvature's Δκ·d.
+    slope_sigma[v] = supported[v] ? 0.0 : std::hypot(g, dkappa * d);
   }
   return sigma;
 }
@@ -346,7 +351,8 @@ DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const 
   for (size_t v = 0; v < x.size(); ++v) out.displacement_m[v] = x[v] - design.vertices[v];
   const double mean_chord = total_area / std::max(1e-9, diagonal(design.vertices));
   out.sigma_m = vertexSigmas(out.fitted, aligned, feet, use, out.supported, out.support_distance_m,
-                             std::max(out.noise_m, 1e-6), 8.0 * p.camber_change_prior / mean_chord);
+                             std::max(out.noise_m, 1e-6), 8.0 * p.camber_change_prior / mean_chord,
+                             out.slope_sigma_rad, out.turn_rad);
   strainAndWarnings(design, top, p, out);
   if (out.samples_used < samples.size() / 2)
     out.warnings.push_back("only " + std::to_string(out.samples_used) + " of " + std::to_string(samples.size()) +

@@ -64,6 +64,12 @@ struct DesignFit {
   std::vector<double> support_distance_m; // per vertex: to the nearest sample, m
   std::vector<char> supported;            // per vertex: support_distance_m ≤ support_radius_m
   std::vector<double> sigma_m;            // per vertex: 1σ of the fitted position along the normal, m
+  // Per vertex: 1σ of the fitted surface's slope where it was inferred (0 where supported: the
+  // samples measure it there), rad.
+  std::vector<double> slope_sigma_rad;
+  // RMS angle between the fitted and the design's normals where supported, rad: how far the
+  // flying surface's slope turned from the design's where it was seen.
+  double turn_rad = 0;
   std::vector<double> edge_strain_pct;    // per mesh edge (edges order): length change from the design, %
   std::vector<std::array<uint32_t, 2>> edges;  // unique edges, i < j
   double support_radius_m = 0;

@@ -31,6 +31,7 @@ nlohmann::json sectionToJson(const Section& s) {
   j["plane_tilt_deg"] = s.plane_tilt_deg;
   j["converged"] = s.converged;
   j["bridged_pct"] = s.bridged_pct;
+  j["inferred_pct"] = s.inferred_pct;
   if (!s.not_measured.empty()) j["not_measured"] = s.not_measured;  // name → why; those values are null
   nlohmann::json curve = nlohmann::json::array();
   for (const Vec3& p : s.curve) curve.push_back(vec(p));

@@ -446,6 +446,14 @@ void outlineSail(const Cloud& input, const Cloud& sail_scan, const std::vector<V
 // from the smoothing's neighbourhoods when there was smoothing.
 void measureSections(const AnalysisParams& p, SailAnalysis& a) {
   StageTimer t(a, "sections", a.mesh.vertices.size());
+  a.sections = cutSections(a.mesh, a.outline, sectionParamsFor(p, a));
+  t.finish(a.sections.sections.size(), a.sections.warnings);
+}
+
+
+}  // namespace
+
+SectionParams sectionParamsFor(const AnalysisParams& p, const SailAnalysis& a) {
   SectionParams sp = p.sections;
   sp.sensor_sigma_m = p.sensor_sigma_m;
   if (p.smooth) {
@@ -455,12 +463,9 @@ void measureSections(const AnalysisParams& p, SailAnalysis& a) {
     const Smoothing& sm = a.smoothing_stats;
     if (sm.k_used > 0) sp.surface_sigma_m = 2.0 * sm.measured_noise_m / std::sqrt(static_cast<double>(sm.k_used));
   }
-  a.sections = cutSections(a.mesh, a.outline, sp);
-  t.finish(a.sections.sections.size(), a.sections.warnings);
+  return sp;
 }
 
-// A length, area or section value that is not a number, or that no measured sail
-// has, is a failure of the analysis to say so, not a result to report.
 void refuseImplausibleResults(const SailAnalysis& a) {
   const SailOutline& o = a.outline;
   const std::pair<double, const char*> lengths[] = {{o.luff_length_m, "the luff"},
@@ -482,8 +487,6 @@ void refuseImplausibleResults(const SailAnalysis& a) {
       throw AnalysisError("[analyzeSail] section " + formatFixed(s.fraction, 2) + " has a value that is not a number");
   }
 }
-
-}  // namespace
 
 Cloud sailSamples(const Cloud& input, const AnalysisParams& p, const Progress& progress) {
   checkAnalysisParams(input, p);
@@ -532,13 +535,15 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     t.finish(cloud.size(), s.warnings);
   }
   meshSurface(cloud, p, progress, a, loose);
+  bool outlined = false;
   try {
     outlineSail(input, sail_scan, working.scan_points, scene, p, a, loose);
+    outlined = true;
     measureSections(p, a);
     refuseImplausibleResults(a);
   } catch (const AnalysisError&) {
     if (surface_only) {
-      a.outline = SailOutline{};
+      if (!outlined || !a.sections.sections.empty()) a.outline = SailOutline{};
       a.sections = SectionAnalysis{};
       a.luff = LuffCurve{};
       a.sail_cloud = std::move(cloud);

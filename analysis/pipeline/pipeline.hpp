@@ -1,12 +1,14 @@
 #pragma once
 // The whole analysis of one flying-sail cloud (SPEC §4 steps 3–6):
 // normals → segmentation → cleaning → smoothing → surface → outline → sections.
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "analysis/core/cloud.hpp"
 #include "analysis/core/mesh.hpp"
 #include "analysis/core/progress.hpp"
+#include "analysis/fit/design_fit.hpp"
 #include "analysis/outline/sail_outline.hpp"
 #include "analysis/sections/luff_curve.hpp"
 #include "analysis/sections/sections.hpp"
@@ -91,6 +93,11 @@ struct SailAnalysis {
   std::vector<SparFit> spars;        // round spars found beside the sail
   std::vector<StageReport> stages;
   std::vector<std::string> warnings; // every stage's warnings, prefixed by stage
+  // Set when the scan alone gave no sections and the sail's design, fitted onto its samples,
+  // stood in for what it did not reach (analysis/pipeline/design_prior.hpp): why the scan
+  // alone refused, and the fit.
+  std::string inferred_because;
+  std::optional<DesignFit> design_fit;
 };
 
 // p.mixed with p's sensor σ.
@@ -118,9 +125,18 @@ Cloud sailSamples(const Cloud& cloud, const AnalysisParams& params = {}, const P
 // a stage cannot produce its result (no sail found, no boundary, ...). When the
 // outline or the sections refuse (a patch of a sail, a scan that never reached a
 // corner) and `surface_only` is given, it receives what was measured before the
-// refusal, the sail's points and surface (outline and sections empty), and the
+// refusal, the sail's points and surface (sections empty; the outline too unless the
+// sections refused it: its coverage says which corners the scan did not reach), and the
 // AnalysisError is thrown on: distances to a design need no outline.
 SailAnalysis analyzeSail(const Cloud& cloud, const AnalysisParams& params = {}, const Progress& progress = {},
                          SailAnalysis* surface_only = nullptr);
+
+// The section parameters for cutting a.mesh: p.sections with p's sensor σ, and the noise
+// model of a's smoothing (its neighbourhoods' radius and the smoothed surface's σ).
+SectionParams sectionParamsFor(const AnalysisParams& p, const SailAnalysis& a);
+
+// Throws AnalysisError for a length, area or section value that is not a number or that no
+// measured sail has: a failure of the analysis to say so, not a result to report.
+void refuseImplausibleResults(const SailAnalysis& a);
 
 }  // namespace sailshape

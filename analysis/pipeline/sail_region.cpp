@@ -113,9 +113,9 @@ void guideByDesign(AnalysisParams& params, const Mesh& design) {
 }
 
 SailAnalysis analyzeInRegion(const Cloud& scan, const RegionBox& region, const Mesh& design, AnalysisParams params,
-                             const Progress& progress) {
+                             const Progress& progress, SailAnalysis* surface_only) {
   guideByDesign(params, design);
-  return analyzeSail(cropToRegion(withoutMixedPixels(scan, params), region), params, progress);
+  return analyzeSail(cropToRegion(withoutMixedPixels(scan, params), region), params, progress, surface_only);
 }
 
 std::string designMismatch(const Mesh& design, const MeshSections& design_sections, const SailAnalysis& flying,
@@ -135,12 +135,17 @@ std::string designMismatch(const Mesh& design, const MeshSections& design_sectio
                {"leech", d.leech_length_m, f.leech_length_m, f.uncertainty.leech_length_m},
                {"foot", d.foot_length_m, f.foot_length_m, f.uncertainty.foot_length_m}};
   for (const auto& e : edges)
-    if (e.design_m > 0 && e.flying_m > 0 && std::abs(e.flying_m - e.design_m) > 0.1 * e.design_m + 3 * e.sigma_m)
+    if (edgeBeyondDesign(e.flying_m, e.design_m, e.sigma_m) != 0)
       off.push_back(std::string(e.name) + " " + percent(e.flying_m / e.design_m) + " of the design's");
   if (off.empty()) return "";
   std::string line = "the analysed surface does not fly like this sail's design: ";
   for (size_t i = 0; i < off.size(); ++i) line += (i ? ", " : "") + off[i];
   return line + "; the scan may hold another sail, or the wrong design was given";
+}
+
+int edgeBeyondDesign(double flying_m, double design_m, double sigma_m) {
+  if (!(design_m > 0 && flying_m > 0) || std::abs(flying_m - design_m) <= 0.1 * design_m + 3 * sigma_m) return 0;
+  return flying_m > design_m ? 1 : -1;
 }
 
 }  // namespace sailshape

@@ -50,9 +50,9 @@ void guideByDesign(AnalysisParams& params, const Mesh& design);
 
 // The scan analysed as its sail: loses its mixed pixels on the whole scan (the
 // surfaces behind tell them), is cropped to `region` and analysed with the pick guided
-// by the design. Throws what analyzeSail and cropToRegion throw.
+// by the design. Throws what analyzeSail and cropToRegion throw; `surface_only` as analyzeSail's.
 SailAnalysis analyzeInRegion(const Cloud& scan, const RegionBox& region, const Mesh& design, AnalysisParams params,
-                             const Progress& progress = {});
+                             const Progress& progress = {}, SailAnalysis* surface_only = nullptr);
 
 // Whether the analysis found the sail it was asked for: empty when it flies as its
 // design could at a plausible trim; otherwise one line saying how far off it is.
@@ -62,5 +62,9 @@ SailAnalysis analyzeInRegion(const Cloud& scan, const RegionBox& region, const M
 // per cent) plus 3σ of the measured length.
 std::string designMismatch(const Mesh& design, const MeshSections& design_sections, const SailAnalysis& flying,
                            const DistanceStats& deviation);
+
+// designMismatch's bound on an edge: a measured length `flying_m` (1σ `sigma_m`) more than 10 %
+// of the design's plus 3σ from `design_m`; > 0 longer, < 0 shorter, 0 within.
+int edgeBeyondDesign(double flying_m, double design_m, double sigma_m);
 
 }  // namespace sailshape

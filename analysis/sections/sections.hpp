@@ -65,6 +65,9 @@ struct Section {
   std::vector<Vec3> curve;            // boat frame, luff to leech
   size_t curve_samples = 0;           // cut points the parameters were computed from
   double bridged_pct = 0;             // % of the chord bridged across holes (see max_bridged_gap)
+  // % of the curve on surface inferred from the sail's design, beyond the scan's samples
+  // (analysis/pipeline/design_prior.hpp); 0 for a section of the scan alone.
+  double inferred_pct = 0;
   // Values this section could not measure, by name ("entry_deg"), with why; each is NaN in
   // `value` and `uncertainty`, and is no result.
   std::map<std::string, std::string> not_measured;

@@ -72,7 +72,47 @@ std::string at(const char* what, double f) {
   return buf;
 }
 
-// Every value the analysis reports, judged; the values of a refused analysis are all refused.
+
+VariantResult analyse(const std::string& name, const Cloud& cloud, const Truth& truth, const SailDesign& design,
+                      const Targets& tg, bool segment = true) {
+  VariantResult r;
+  r.variant = name;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    // As `sailshape analyze FILE` runs it: default parameters, the scene segmented first.
+    AnalysisParams params;
+    params.segment = segment;
+    const SailAnalysis a = analyzeSail(cloud, params);
+    r.seconds = seconds(t0);
+    r.sail_points = a.sail_points;
+    judgeAnalysis(&a, "", truth, design, tg, r);
+  } catch (const std::runtime_error& e) {  // AnalysisError; InvalidInput for a scan that kept no point
+    if (!dynamic_cast<const AnalysisError*>(&e) && !dynamic_cast<const InvalidInput*>(&e)) throw;
+    r.seconds = seconds(t0);
+    r.refused = true;
+    r.refusal = e.what();
+    judgeAnalysis(nullptr, r.refusal, truth, design, tg, r);
+  }
+  return r;
+}
+
+json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+json designJson(const SailDesign& d) {
+  json stations = json::array();
+  for (const ProfileStation& s : d.stations)
+    stations.push_back({{"fraction", s.fraction}, {"camber_pct", s.camber_pct}, {"draft_pct", s.draft_pct},
+                        {"twist_deg", s.twist_deg}, {"entry_factor", s.entry_factor}, {"exit_factor", s.exit_factor}});
+  // The keys of a SCENE.json "sail" object (acquisition/README.md), so the design can be rebuilt by hand.
+  return {{"sail_type", sailTypeName(d.type)}, {"luff_m", d.luff_m},       {"leech_m", d.leech_m},
+          {"foot_m", d.foot_m},                {"head_width_m", d.head_width_m}, {"tack", vec(d.tack)},
+          {"rake_deg", d.rake_deg},            {"luff_round_m", d.luff_round_m}, {"luff_sag_m", d.luff_sag_m},
+          {"leech_round_m", d.leech_round_m},  {"lean_deg", d.lean_deg},       {"leeward_port", d.leeward_port},
+          {"stations", stations}};
+}
+
+}  // namespace
+
 void judgeAnalysis(const SailAnalysis* a, const std::string& refusal, const Truth& truth, const SailDesign& design,
                    const Targets& tg, VariantResult& out) {
   const SailSurface surface(design);
@@ -120,46 +160,6 @@ void judgeAnalysis(const SailAnalysis* a, const std::string& refusal, const Trut
   if (o.has_peak && truth.has_peak)
     out.values.push_back(scalar("top_length_m", o.top_length_m, u.top_length_m, truth.top_m, tg.length_m));
 }
-
-VariantResult analyse(const std::string& name, const Cloud& cloud, const Truth& truth, const SailDesign& design,
-                      const Targets& tg, bool segment = true) {
-  VariantResult r;
-  r.variant = name;
-  const auto t0 = std::chrono::steady_clock::now();
-  try {
-    // As `sailshape analyze FILE` runs it: default parameters, the scene segmented first.
-    AnalysisParams params;
-    params.segment = segment;
-    const SailAnalysis a = analyzeSail(cloud, params);
-    r.seconds = seconds(t0);
-    r.sail_points = a.sail_points;
-    judgeAnalysis(&a, "", truth, design, tg, r);
-  } catch (const std::runtime_error& e) {  // AnalysisError; InvalidInput for a scan that kept no point
-    if (!dynamic_cast<const AnalysisError*>(&e) && !dynamic_cast<const InvalidInput*>(&e)) throw;
-    r.seconds = seconds(t0);
-    r.refused = true;
-    r.refusal = e.what();
-    judgeAnalysis(nullptr, r.refusal, truth, design, tg, r);
-  }
-  return r;
-}
-
-json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
-
-json designJson(const SailDesign& d) {
-  json stations = json::array();
-  for (const ProfileStation& s : d.stations)
-    stations.push_back({{"fraction", s.fraction}, {"camber_pct", s.camber_pct}, {"draft_pct", s.draft_pct},
-                        {"twist_deg", s.twist_deg}, {"entry_factor", s.entry_factor}, {"exit_factor", s.exit_factor}});
-  // The keys of a SCENE.json "sail" object (acquisition/README.md), so the design can be rebuilt by hand.
-  return {{"sail_type", sailTypeName(d.type)}, {"luff_m", d.luff_m},       {"leech_m", d.leech_m},
-          {"foot_m", d.foot_m},                {"head_width_m", d.head_width_m}, {"tack", vec(d.tack)},
-          {"rake_deg", d.rake_deg},            {"luff_round_m", d.luff_round_m}, {"luff_sag_m", d.luff_sag_m},
-          {"leech_round_m", d.leech_round_m},  {"lean_deg", d.lean_deg},       {"leeward_port", d.leeward_port},
-          {"stations", stations}};
-}
-
-}  // namespace
 
 std::string verdictName(Verdict v) {
   switch (v) {

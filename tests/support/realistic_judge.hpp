@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/pipeline/pipeline.hpp"
 #include "tests/support/realistic_scene.hpp"
 #include "tests/support/realistic_sweep.hpp"
 
@@ -71,6 +72,11 @@ struct RunOptions {
   // on these sails without the one-unit scan's density changes and gaps.
   bool even_control = false;
 };
+
+// Every value `a` reports judged against `truth` (the flying sail `design`'s), into out.values;
+// with `a` null, every value refused for `refusal`.
+void judgeAnalysis(const SailAnalysis* a, const std::string& refusal, const Truth& truth, const SailDesign& design,
+                   const Targets& targets, VariantResult& out);
 
 // Draws the configuration from `seed`, sweeps it and judges both analyses.
 ConfigRun runSeed(uint64_t seed, const RunOptions& options = {});
