@@ -5,10 +5,12 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "analysis/core/errors.hpp"
 #include "analysis/design/design_compare.hpp"
+#include "analysis/fit/design_fit.hpp"
 #include "analysis/io/cloud_io.hpp"
 #include "analysis/io/design_import.hpp"
 #include "analysis/io/mesh_io.hpp"
@@ -23,7 +25,7 @@ namespace sailshape::cli {
 namespace {
 
 struct CompareOptions {
-  std::string design, flying, unit = "auto", axes = "auto", json_out, params_file, distances_out;
+  std::string design, flying, unit = "auto", axes = "auto", json_out, params_file, distances_out, whole_sail_out;
   int sections = 3;
   bool no_segment = false, raw_distances = false, quiet = false;
 };
@@ -39,6 +41,69 @@ bool plyHasFaces(const std::string& path) {
   return false;
 }
 
+// The whole sail's deviation from its design (--whole-sail): the design fitted onto the flying
+// shape, each vertex's move along the design's normal (positive to leeward), split by whether
+// samples held it (scanned) or the fit carried it on from around (inferred).
+struct WholeSail {
+  DesignFit fit;
+  std::vector<double> deviation_m;  // per design vertex
+  DistanceStats scanned, inferred;
+  double inferred_sigma_p50_m = 0, inferred_sigma_max_m = 0;  // the inferred vertices' σ
+};
+
+WholeSail wholeSail(const Mesh& design, const std::vector<Vec3>& samples, const Vec3& leeward, const Progress& progress) {
+  WholeSail w;
+  w.fit = fitDesign(design, samples, {}, progress);
+  const std::vector<Vec3> normals = vertexNormals(design);
+  std::vector<double> scanned, inferred, sigma;
+  w.deviation_m.resize(design.vertices.size());
+  for (size_t v = 0; v < design.vertices.size(); ++v) {
+    const Vec3 n = normals[v].dot(leeward) < 0 ? Vec3(-normals[v]) : normals[v];
+    w.deviation_m[v] = w.fit.displacement_m[v].dot(n);
+    if (w.fit.supported[v]) {
+      scanned.push_back(w.deviation_m[v]);
+    } else {
+      inferred.push_back(w.deviation_m[v]);
+      sigma.push_back(w.fit.sigma_m[v]);
+    }
+  }
+  if (!scanned.empty()) w.scanned = distanceStats(scanned);
+  if (!inferred.empty()) w.inferred = distanceStats(inferred);
+  if (!sigma.empty()) {
+    std::sort(sigma.begin(), sigma.end());
+    w.inferred_sigma_p50_m = sigma[sigma.size() / 2];
+    w.inferred_sigma_max_m = sigma.back();
+  }
+  return w;
+}
+
+// The fitted design as an ASCII PLY mesh whose vertices carry deviation_mm (along the design's
+// normal, + leeward), sigma_mm (1σ of that) and scanned (1: samples hold it, 0: inferred).
+void writeWholeSail(const std::string& path, const WholeSail& w) {
+  std::ofstream out(path);
+  if (!out) throw FileError(path + ": cannot write");
+  const Mesh& m = w.fit.fitted;
+  out << "ply\nformat ascii 1.0\ncomment sailshape compare --whole-sail: the design fitted onto the flying shape\n"
+      << "element vertex " << m.vertices.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nproperty float deviation_mm\n"
+         "property float sigma_mm\nproperty uchar scanned\nelement face "
+      << m.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  char line[160];
+  for (size_t v = 0; v < m.vertices.size(); ++v) {
+    const Vec3& p = m.vertices[v];
+    std::snprintf(line, sizeof line, "%.5f %.5f %.5f %.2f %.2f %d\n", p.x(), p.y(), p.z(), 1000 * w.deviation_m[v],
+                  1000 * w.fit.sigma_m[v], w.fit.supported[v] ? 1 : 0);
+    out << line;
+  }
+  for (const auto& t : m.triangles) out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  if (!out) throw FileError(path + ": write failed");
+}
+
+nlohmann::json statsJson(const DistanceStats& s) {
+  return {{"count", s.count}, {"mean_m", s.mean_m}, {"rms_m", s.rms_m}, {"max_abs_m", s.max_abs_m},
+          {"p5_m", s.p5_m},   {"p50_m", s.p50_m},   {"p95_m", s.p95_m}};
+}
+
 // A section asked of both sides that one of them could not measure: it has no delta.
 struct MissingSection {
   double fraction;
@@ -47,7 +112,8 @@ struct MissingSection {
 };
 
 void printTable(const CompareOptions& o, const DesignImport& design, const DesignComparison& c, const std::string& what,
-                const std::vector<MissingSection>& missing, const std::string& outline_refused) {
+                const std::vector<MissingSection>& missing, const std::string& outline_refused,
+                const std::optional<WholeSail>& whole) {
   std::printf("Design %s (%s, %s, %s axes)\nFlying %s\n", o.design.c_str(), design.format.c_str(), design.unit.c_str(),
               design.axes.c_str(), o.flying.c_str());
   const DistanceStats& s = c.stats;
@@ -55,6 +121,25 @@ void printTable(const CompareOptions& o, const DesignImport& design, const Desig
               s.count, what.c_str(), c.leeward.x(), c.leeward.y(), c.leeward.z());
   std::printf("  mean %+.1f  rms %.1f  max |d| %.1f  p5 %+.1f  p50 %+.1f  p95 %+.1f\n", 1000 * s.mean_m, 1000 * s.rms_m,
               1000 * s.max_abs_m, 1000 * s.p5_m, 1000 * s.p50_m, 1000 * s.p95_m);
+  if (whole) {
+    const WholeSail& w = *whole;
+    std::printf("\nThe whole sail: the design fitted onto the flying shape (%.0f %% of its area within %.0f mm of a "
+                "sample), each design point's move along its normal (mm, positive to leeward):\n",
+                100 * w.fit.coverage, 1000 * w.fit.support_radius_m);
+    auto line = [](const char* name, const DistanceStats& s) {
+      std::printf("  %-9s %6zu points: mean %+.1f  rms %.1f  p5 %+.1f  p95 %+.1f  max |d| %.1f\n", name, s.count,
+                  1000 * s.mean_m, 1000 * s.rms_m, 1000 * s.p5_m, 1000 * s.p95_m, 1000 * s.max_abs_m);
+    };
+    line("scanned", w.scanned);
+    if (w.inferred.count > 0) {
+      line("inferred", w.inferred);
+      std::printf("            (inferred where the scan has no samples: σ median %.1f, largest %.1f)\n",
+                  1000 * w.inferred_sigma_p50_m, 1000 * w.inferred_sigma_max_m);
+    }
+    std::printf("  stretch where scanned: p5 %+.2f %%, p95 %+.2f %%\n", w.fit.strain_supported.p5_pct,
+                w.fit.strain_supported.p95_pct);
+    std::printf("  written to %s\n", o.whole_sail_out.c_str());
+  }
   if (!outline_refused.empty())
     std::printf("\nOutline and sections not measured on the flying shape: %s\n", outline_refused.c_str());
   std::printf("\nSections: design / flying (flying - design)\n");
@@ -93,6 +178,7 @@ void run(const CompareOptions& o) {
   MeshSections design_sections = analyzeMeshSections(design.mesh, {}, sp);
 
   std::vector<Vec3> points;
+  std::vector<Vec3> fit_samples;  // the flying shape's own points for --whole-sail
   SectionAnalysis flying_sections;
   std::vector<std::string> warnings;
   std::string what;
@@ -116,6 +202,7 @@ void run(const CompareOptions& o) {
       outline_refused = userMessage(e.what());
     }
     points = flying.vertices;
+    fit_samples = flying.vertices;
     what = "flying mesh vertices";
   } else {
     AnalysisParams params = o.params_file.empty() ? AnalysisParams{} : loadParams(o.params_file);
@@ -137,6 +224,7 @@ void run(const CompareOptions& o) {
     }
     flying_sections = a.sections;
     warnings = a.warnings;
+    if (!o.whole_sail_out.empty()) fit_samples = a.sail_cloud.points;
     if (o.raw_distances) {
       points = std::move(read.cloud.points);
       what = "flying points (as read)";
@@ -148,6 +236,12 @@ void run(const CompareOptions& o) {
   if (!outline_refused.empty())
     for (double fraction : sectionFractions(sp)) flying_sections.unmeasured.push_back({fraction, "no outline on the flying shape"});
   DesignComparison c = compareWithDesign(design.mesh, design_sections.sections, points, flying_sections, bar.progress());
+  std::optional<WholeSail> whole;
+  if (!o.whole_sail_out.empty()) {
+    whole = wholeSail(design.mesh, fit_samples, c.leeward, bar.progress());
+    writeWholeSail(o.whole_sail_out, *whole);
+    for (const std::string& w : whole->fit.warnings) c.warnings.push_back("whole sail: " + w);
+  }
   bar.finish();
   c.warnings.insert(c.warnings.begin(), warnings.begin(), warnings.end());
   for (const std::string& w : design_sections.sections.warnings) c.warnings.push_back("design: " + w);
@@ -165,7 +259,7 @@ void run(const CompareOptions& o) {
     if (!o.quiet) std::fprintf(stderr, "wrote %s (intensity = signed distance, mm)\n", o.distances_out.c_str());
   }
   if (o.json_out.empty()) {
-    printTable(o, design, c, what, missing, outline_refused);
+    printTable(o, design, c, what, missing, outline_refused, whole);
     return;
   }
   nlohmann::json doc;
@@ -188,6 +282,20 @@ void run(const CompareOptions& o) {
   doc["unmeasured_sections"] = nlohmann::json::array();
   for (const MissingSection& m : missing)
     doc["unmeasured_sections"].push_back({{"fraction", m.fraction}, {"side", m.side}, {"reason", m.reason}});
+  if (whole) {
+    const WholeSail& w = *whole;
+    doc["whole_sail"] = {{"file", o.whole_sail_out},
+                         {"coverage", w.fit.coverage},
+                         {"support_radius_m", w.fit.support_radius_m},
+                         {"scanned", statsJson(w.scanned)},
+                         {"inferred", statsJson(w.inferred)},
+                         {"inferred_sigma_p50_m", w.inferred_sigma_p50_m},
+                         {"inferred_sigma_max_m", w.inferred_sigma_max_m},
+                         {"strain_scanned_p5_pct", w.fit.strain_supported.p5_pct},
+                         {"strain_scanned_p95_pct", w.fit.strain_supported.p95_pct}};
+  } else {
+    doc["whole_sail"] = nullptr;
+  }
   doc["warnings"] = c.warnings;
   writeJsonFile(o.json_out, doc);
   if (!o.quiet) std::fprintf(stderr, "wrote %s\n", o.json_out.c_str());
@@ -216,6 +324,12 @@ void addCompareCommand(CLI::App& app) {
   cmd->add_option("--distances", opt->distances_out,
                   "Write the flying points with their signed distance in mm as the intensity field (.ply, .pcd, "
                   ".xyz, .csv): the colour map");
+  cmd->add_option("--whole-sail", opt->whole_sail_out,
+                  "Fit the design onto the flying shape (as `sailshape fit`) and write the whole sail's deviation map "
+                  "to this .ply: the fitted design's mesh, each vertex with deviation_mm (its move along the design's "
+                  "normal, positive to leeward), sigma_mm (1σ) and scanned (1: samples hold it; 0: inferred where the "
+                  "scan has none, carried on from around). The table and JSON give the statistics of the scanned "
+                  "and inferred parts apart, and the stretch where scanned");
   addDesignFileOptions(cmd, opt->unit, opt->axes);
   cmd->add_option("--params", opt->params_file, "Pipeline parameters file for a flying cloud (see analyze "
                                                 "--print-params)");

@@ -40,7 +40,8 @@ const std::vector<CommandExamples>& examples() {
         "sailshape design show a2-design.stl --unit m --axes boat --json a2-design.json"}},
       {"compare",
        {"sailshape compare --design main-design.obj --flying main.ply --no-segment --json compare.json",
-        "sailshape compare --design main-design.obj --flying main.ply --no-segment --distances deviation.ply"}},
+        "sailshape compare --design main-design.obj --flying main.ply --no-segment --distances deviation.ply "
+        "--whole-sail whole-sail.ply"}},
       {"fit",
        {"sailshape fit --design main-design.obj --flying main.ply --no-segment --out main-fitted.ply --json fit.json",
         "sailshape fit --design main-design.obj --flying assets/sample-main-scene.ply --out main-fitted.obj "

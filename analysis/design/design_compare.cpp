@@ -306,6 +306,17 @@ Cloud sampleMesh(const Mesh& mesh, size_t points, uint64_t seed) {
   return cloud;
 }
 
+double plausibleTrimDeviationM(const Mesh& design) {
+  const double area = meshArea(design);
+  Eigen::AlignedBox3d box;
+  for (const Vec3& v : design.vertices) box.extend(v);
+  const double height = box.isEmpty() ? 0 : box.sizes().z();
+  if (!(area > 0) || !(height > 0))
+    throw InvalidInput("[plausibleTrimDeviationM] the design has no area or no height (area " + std::to_string(area) +
+                       " m², height " + std::to_string(height) + " m)");
+  return 0.2 * area / height;
+}
+
 MeshSections analyzeMeshSections(const Mesh& mesh, const OutlineParams& outline, const SectionParams& sections,
                                  const MeshSampling& sampling) {
   if (sampling.mode != "auto" && sampling.mode != "mesh" && sampling.mode != "resample")

@@ -108,6 +108,15 @@ BoundaryCount countBoundary(const Mesh& mesh);
 // `points` samples spread uniformly over the mesh's area (fixed seed).
 Cloud sampleMesh(const Mesh& mesh, size_t points, uint64_t seed = 1);
 
+// How far from its design a sail may fly at a plausible trim, m: 0.2 × the design's
+// mean chord (area over height). Trim moves the cloth by a camber change (±5 % of the
+// chord, at the deepest point), by twist (±10° at the head about the luff: the leech
+// moves chord × sin 10° = 0.17 chord) and by the sheeting angle; together up to about a
+// fifth of the chord at the leech, less on average over the sail. Another sail, a wall
+// or the wrong side of a tunnel lies a whole chord or more away. Throws InvalidInput
+// for a design without area or height.
+double plausibleTrimDeviationM(const Mesh& design);
+
 struct SectionDelta {
   double fraction = 0;
   SectionParameters design, flying;

@@ -353,6 +353,16 @@ DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const 
   out.sigma_m = vertexSigmas(out.fitted, aligned, feet, use, out.supported, out.support_distance_m,
                              std::max(out.noise_m, 1e-6), 8.0 * p.camber_change_prior / mean_chord,
                              out.slope_sigma_rad, out.turn_rad);
+  // Far from the samples σ grows as g·d and ½·Δκ·d² without bound; the flying sail strays from its
+  // design by no more than a plausible trim (plausibleTrimDeviationM, taken as 2σ), so a vertex lies
+  // no farther from it than from the design plus that. A design without height has no such bound.
+  double trim_sigma = HUGE_VAL;
+  try {
+    trim_sigma = 0.5 * plausibleTrimDeviationM(design);
+  } catch (const InvalidInput&) {
+  }
+  for (size_t v = 0; v < out.sigma_m.size(); ++v)
+    out.sigma_m[v] = std::min(out.sigma_m[v], (out.fitted.vertices[v] - aligned.vertices[v]).norm() + trim_sigma);
   strainAndWarnings(design, top, p, out);
   if (out.samples_used < samples.size() / 2)
     out.warnings.push_back("only " + std::to_string(out.samples_used) + " of " + std::to_string(samples.size()) +

@@ -42,7 +42,8 @@ struct DesignFitParams {
   // fraction of the chord (0.03: 3 % of chord, a trim step's change). A parabolic section of
   // depth c·chord bends at 8c/chord, so the curvature may differ by Δκ = 8·0.03/chord, the
   // mean chord being the design's area over its height; σ grows as ½·Δκ·d² with the distance
-  // d from the samples, besides the g·d of the slope's turn (see fitDesign).
+  // d from the samples, besides the g·d of the slope's turn (see fitDesign), and never beyond the
+  // vertex's move from the design plus half a plausible trim (plausibleTrimDeviationM).
   double camber_change_prior = 0.03;
   // Stretch beyond this (per-edge length change, %) is warned about: see fitDesign.
   double max_plausible_strain_pct = 5.0;

@@ -25,16 +25,6 @@ std::string percent(double ratio) { return std::to_string(static_cast<long>(std:
 
 }  // namespace
 
-double plausibleTrimDeviationM(const Mesh& design) {
-  const double area = meshArea(design);
-  const Eigen::AlignedBox3d box = boundsOf(design);
-  const double height = box.isEmpty() ? 0 : box.sizes().z();
-  if (!(area > 0) || !(height > 0))
-    throw InvalidInput("[plausibleTrimDeviationM] the design has no area or no height (area " + std::to_string(area) +
-                       " m², height " + std::to_string(height) + " m)");
-  return 0.2 * area / height;
-}
-
 RegionBox designRegion(const Mesh& design, double margin_m) {
   if (design.vertices.empty()) throw InvalidInput("[designRegion] the design has no vertices");
   if (!(margin_m >= 0) || !std::isfinite(margin_m))
