@@ -265,4 +265,47 @@ SailViews renderSailViews(const Mesh& design, const Mesh& flying, const std::vec
   return views;
 }
 
+Rgb mutedColour(const Rgb& c) {
+  constexpr double kGrey = 0.86, kShare = 0.75;
+  return {kShare * kGrey + (1 - kShare) * c[0], kShare * kGrey + (1 - kShare) * c[1], kShare * kGrey + (1 - kShare) * c[2]};
+}
+
+RgbImage renderColouredSide(const Mesh& mesh, const std::vector<double>& values, double range,
+                            const std::vector<char>& muted, const PictureSize& size) {
+  if (mesh.empty()) throw InvalidInput("[renderColouredSide] the mesh has no triangles");
+  if (values.size() != mesh.vertices.size() || muted.size() != mesh.vertices.size())
+    throw InvalidInput("[renderColouredSide] " + std::to_string(values.size()) + " values and " +
+                       std::to_string(muted.size()) + " flags for " + std::to_string(mesh.vertices.size()) + " vertices");
+  if (size.width_px < 16 || size.height_px < 16 || size.width_px > 4096 || size.height_px > 4096)
+    throw InvalidInput("[renderColouredSide] picture size must be 16..4096 px");
+  const LeakCheckPause pause;
+  vtkNew<vtkPolyData> coloured = surfaceOf(mesh);
+  vtkNew<vtkUnsignedCharArray> colours;
+  colours->SetNumberOfComponents(3);
+  colours->SetName("values");
+  colours->SetNumberOfTuples(static_cast<vtkIdType>(values.size()));
+  for (size_t i = 0; i < values.size(); ++i) {
+    Rgb c = deviationColour(values[i], range);
+    if (muted[i]) c = mutedColour(c);
+    for (int k = 0; k < 3; ++k) colours->SetComponent(static_cast<vtkIdType>(i), k, std::round(255 * c[k]));
+  }
+  coloured->GetPointData()->SetScalars(colours);
+  vtkNew<vtkActor> actor = surfaceActor(coloured);
+  actor->GetProperty()->SetAmbient(0.6);
+  actor->GetProperty()->SetDiffuse(0.4);
+  actor->GetProperty()->SetSpecular(0.0);
+  actor->GetMapper()->SetScalarModeToUsePointData();
+  actor->GetMapper()->SetColorModeToDirectScalars();
+  actor->GetMapper()->ScalarVisibilityOn();
+  vtkNew<vtkRenderer> renderer;
+  renderer->SetBackground(1, 1, 1);
+  renderer->AddActor(actor);
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->AddRenderer(renderer);
+  window->SetSize(size.width_px, size.height_px);
+  placeCamera(renderer->GetActiveCamera(), View::Side, mesh.vertices, size);
+  return capture(window);
+}
+
 }  // namespace sailshape

@@ -49,6 +49,16 @@ struct SailViews {
 SailViews renderSailViews(const Mesh& design, const Mesh& flying, const std::vector<double>& deviation_m,
                           const RenderParams& params = {});
 
+// The side view of `mesh` coloured per vertex by `values` (deviationColour over ±range);
+// vertices flagged in `muted` are drawn pale, blended three quarters towards light grey (what
+// was inferred rather than measured). Throws as renderSailViews does, and InvalidInput for a
+// value or flag list of the wrong length.
+RgbImage renderColouredSide(const Mesh& mesh, const std::vector<double>& values, double range,
+                            const std::vector<char>& muted, const PictureSize& size);
+
+// The colour a muted vertex is drawn in.
+Rgb mutedColour(const Rgb& colour);
+
 struct RenderError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };

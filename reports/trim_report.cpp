@@ -143,6 +143,25 @@ struct ViewLayout {
   float side_w = 190, astern_w = 90, row1_h = 330, gap = 20.5f, top_w = 250, top_h = 190;
 };
 
+// The deviation colour scale from −range to +range, `w` wide at (x, y), labelled at −, −½, 0,
+// +½, + range in `to_units` × the value printed with `f`. Returns the y below its labels.
+float colourScale(PdfDocument& pdf, float x, float y, float w, double range, double to_units, const char* f) {
+  const float bh = 10;
+  const int n = 100;
+  for (int i = 0; i < n; ++i) {
+    const double t = -range + 2 * range * (i + 0.5) / n;
+    pdf.rect(x + w * i / n, y, w / n + 0.3f, bh, deviationColour(t, range));
+  }
+  pdf.frame(x, y, w, bh, 0.4f, kRule);
+  for (int k = -2; k <= 2; ++k) {
+    const float tx = x + w * (k + 2) / 4.0f;
+    pdf.line(tx, y + bh, tx, y + bh + 3, 0.5f, kGrey);
+    pdf.text(tx, y + bh + 12, signedFmt(k == 0 ? "%.0f" : f, to_units * range * k / 2), 8, false, kBlack,
+             k == -2 ? Align::Left : k == 2 ? Align::Right : Align::Centre);
+  }
+  return y + bh + 22;
+}
+
 void viewsPage(PdfDocument& pdf, Pages& pages, const ReportData& d, const ReportStep& step, const StepComparison& c,
                const SailViews& v, double range_m) {
   float y = pages.start("Shape in 3D · " + stepLabel(d, step) + " · " + conditions(step));
@@ -175,21 +194,7 @@ void viewsPage(PdfDocument& pdf, Pages& pages, const ReportData& d, const Report
                               : "flying shape, the surface reconstructed from the scan",
                      8.5f) + 14;
   pdf.text(lx, ly, "Deviation, mm", 9.5f, true, kNavy);
-  ly += 10;
-  const float bh = 10;
-  const int n = 100;
-  for (int i = 0; i < n; ++i) {
-    const double t = -range_m + 2 * range_m * (i + 0.5) / n;
-    pdf.rect(lx + lw * i / n, ly, lw / n + 0.3f, bh, deviationColour(t, range_m));
-  }
-  pdf.frame(lx, ly, lw, bh, 0.4f, kRule);
-  for (int k = -2; k <= 2; ++k) {
-    const float tx = lx + lw * (k + 2) / 4.0f;
-    pdf.line(tx, ly + bh, tx, ly + bh + 3, 0.5f, kGrey);
-    pdf.text(tx, ly + bh + 12, signedFmt(k == 0 ? "%.0f" : "%+.0f", 1000 * range_m * k / 2), 8, false, kBlack,
-             k == -2 ? Align::Left : k == 2 ? Align::Right : Align::Centre);
-  }
-  ly += bh + 28;
+  ly = colourScale(pdf, lx, ly + 10, lw, range_m, 1000, "%+.0f") + 6;
   ly = pdf.paragraph(lx, ly, lw,
                      "Signed distance of the flying shape to the design surface: + to leeward (fuller than "
                      "designed), − to windward.",
@@ -200,6 +205,74 @@ void viewsPage(PdfDocument& pdf, Pages& pages, const ReportData& d, const Report
                     " mm, 90 % between " + signedFmt("%+.1f", 1000 * s.p5_m) + " and " +
                     signedFmt("%+.1f", 1000 * s.p95_m) + " mm, largest " + fmt("%.1f", 1000 * s.max_abs_m) + " mm.",
                 8.5f);
+}
+
+// The pictures of the design-moved page.
+struct MovedViews {
+  RgbImage normal, stretch;
+  double normal_range_m = 0, stretch_range_pct = 0;
+};
+
+// "Where the design moved": the design fitted onto the last step's surface, its move along its
+// normal and its stretch, side by side, the inferred parts drawn pale, and the numbers beneath.
+void movedPage(PdfDocument& pdf, Pages& pages, const ReportData& d, const ReportStep& step, const DesignMoved& m,
+               const MovedViews& v) {
+  float y = pages.start("Where the design moved · " + stepLabel(d, step));
+  const ViewLayout L;
+  const float w = L.side_w, h = L.row1_h, gap = 60;
+  float x = 0.5f * (pdf.pageWidth() - 2 * w - gap);
+  struct Panel {
+    const RgbImage& image;
+    std::string caption, unit;
+    double range, to_units;
+    const char* f;
+  } panels[] = {{v.normal, "Move along the design's normal", "mm, + to leeward", v.normal_range_m, 1000, "%+.0f"},
+                {v.stretch, "Stretch of the cloth", "% of the design's lengths", v.stretch_range_pct, 1, "%+.1f"}};
+  for (const Panel& p : panels) {
+    pdf.image(p.image, x, y, w, h);
+    pdf.frame(x, y, w, h, 0.5f, kRule);
+    pdf.text(x + w / 2, y + h + 12, p.caption + ", " + p.unit, 8.5f, false, kBlack, Align::Centre);
+    colourScale(pdf, x, y + h + 22, w, p.range, p.to_units, p.f);
+    x += w + gap;
+  }
+  // Beneath the pictures: what pale means, and the numbers.
+  const float lx = kMargin, lw = pdf.pageWidth() - 2 * kMargin;
+  float ly = y + h + 72;
+  const DesignFit& f = m.fit;
+  pdf.text(lx, ly, "The design fitted to the scan", 9.5f, true, kNavy);
+  ly = pdf.paragraph(lx, ly + 14, lw,
+                     "Each point of the design, moved to where the sail flew: through the scan's samples where "
+                     "it has them, carried on smoothly from around where it has none.",
+                     8.5f) + 8;
+  pdf.rect(lx, ly - 8, 18, 8, mutedColour(deviationColour(0, v.normal_range_m)));
+  ly = pdf.paragraph(lx + 24, ly, lw - 24,
+                     "pale: inferred, no sample within " + fmt("%.0f", 1000 * f.support_radius_m) + " mm (" +
+                         fmt("%.0f", 100 * (1 - f.coverage)) + " % of the area)",
+                     8.5f) + 10;
+  auto stats = [&](const std::string& what, const DistanceStats& s) {
+    ly = pdf.paragraph(lx, ly, lw,
+                       what + ": mean " + signedFmt("%+.0f", 1000 * s.mean_m) + " mm, 90 % between " +
+                           signedFmt("%+.0f", 1000 * s.p5_m) + " and " + signedFmt("%+.0f", 1000 * s.p95_m) + " mm.",
+                       8.5f) + 6;
+  };
+  stats("Scanned, along the normal", m.normal_scanned);
+  if (m.normal_inferred.count > 0) {
+    stats("Inferred, along the normal", m.normal_inferred);
+    ly = pdf.paragraph(lx, ly, lw,
+                       "Where inferred the fit is known to ±" + fmt("%.0f", 1000 * m.inferred_sigma_p50_m) +
+                           " mm (1σ, median): more near the last samples, less far from them.",
+                       8.5f, false, kGrey) + 6;
+  }
+  ly = pdf.paragraph(lx, ly, lw,
+                     "Along the sail, scanned: median " + fmt("%.0f", 1000 * m.along_scanned.p50_m) + " mm, 95 % under " +
+                         fmt("%.0f", 1000 * m.along_scanned.p95_m) + " mm.",
+                     8.5f) + 6;
+  ly = pdf.paragraph(lx, ly, lw,
+                     "Stretch where scanned: 90 % between " + signedFmt("%+.2f", f.strain_supported.p5_pct) + " and " +
+                         signedFmt("%+.2f", f.strain_supported.p95_pct) + " %. Through the samples: RMS " +
+                         fmt("%.1f", 1000 * f.rms_m) + " mm.",
+                     8.5f) + 6;
+  for (const std::string& warning : f.warnings) ly = pdf.paragraph(lx, ly, lw, warning, 8, false, kGrey) + 4;
 }
 
 // The sail's outline, design beside flying: edge lengths, area, and the luff
@@ -416,6 +489,55 @@ Mesh loftSections(const std::vector<ReportSection>& sections, int columns, int r
   return mesh;
 }
 
+namespace {
+
+// The design fitted onto a step's surface (analysis/fit), and what the page shows of it.
+DesignMoved designMoved(const Mesh& design, const std::vector<Vec3>& surface, const Vec3& leeward,
+                        const Progress& progress) {
+  DesignMoved m;
+  m.fit = fitDesign(design, surface, {}, progress);
+  const size_t n = design.vertices.size();
+  const std::vector<Vec3> normals = vertexNormals(design);
+  m.normal_m.resize(n);
+  m.along_m.resize(n);
+  m.inferred.resize(n);
+  std::vector<double> scanned, inferred, along, sigma;
+  for (size_t v = 0; v < n; ++v) {
+    const Vec3 nv = normals[v].dot(leeward) < 0 ? Vec3(-normals[v]) : normals[v];
+    const Vec3& d = m.fit.displacement_m[v];
+    m.normal_m[v] = d.dot(nv);
+    m.along_m[v] = (d - m.normal_m[v] * nv).norm();
+    m.inferred[v] = !m.fit.supported[v];
+    if (m.inferred[v]) {
+      inferred.push_back(m.normal_m[v]);
+      sigma.push_back(m.fit.sigma_m[v]);
+    } else {
+      scanned.push_back(m.normal_m[v]);
+      along.push_back(m.along_m[v]);
+    }
+  }
+  // A vertex's stretch: the mean length change of the edges it ends.
+  m.stretch_pct.assign(n, 0.0);
+  std::vector<int> edges_at(n, 0);
+  for (size_t e = 0; e < m.fit.edges.size(); ++e)
+    for (uint32_t v : m.fit.edges[e]) {
+      m.stretch_pct[v] += m.fit.edge_strain_pct[e];
+      ++edges_at[v];
+    }
+  for (size_t v = 0; v < n; ++v)
+    if (edges_at[v] > 0) m.stretch_pct[v] /= edges_at[v];
+  if (!scanned.empty()) m.normal_scanned = distanceStats(scanned);
+  if (!inferred.empty()) m.normal_inferred = distanceStats(inferred);
+  if (!along.empty()) m.along_scanned = distanceStats(along);
+  if (!sigma.empty()) {
+    std::nth_element(sigma.begin(), sigma.begin() + sigma.size() / 2, sigma.end());
+    m.inferred_sigma_p50_m = sigma[sigma.size() / 2];
+  }
+  return m;
+}
+
+}  // namespace
+
 TrimReportData prepareTrimReport(const TrimReportParams& p, const Progress& progress) {
   validate(p);
   progress("loading", 0);
@@ -484,6 +606,8 @@ TrimReportData prepareTrimReport(const TrimReportParams& p, const Progress& prog
   }
   r.summary = summarizeDifferences(r.steps.back().sections, p.summary);
   progress("design", 1);
+  if (const ReportStep& last = r.data.steps.back(); p.audience == "designer" && last.surface && !last.surface->empty())
+    r.moved = designMoved(*r.data.design_mesh, last.surface->vertices, distance.leeward(), progress);
   return r;
 }
 
@@ -507,6 +631,7 @@ TrimReport writeTrimReport(const TrimReportParams& p, const Progress& progress) 
 
   progress("rendering", 0);
   std::vector<SailViews> views;
+  MovedViews moved;
   {
     PrivateDisplay display;
     out.private_display = display.started();
@@ -516,6 +641,19 @@ TrimReport writeTrimReport(const TrimReportParams& p, const Progress& progress) 
     for (size_t i = first; i < r.steps.size(); ++i) {
       views.push_back(renderSailViews(*r.data.design_mesh, r.steps[i].flying_surface, r.steps[i].deviation_m, rp));
       progress("rendering", double(i + 1 - first) / (r.steps.size() - first));
+    }
+    if (r.moved) {
+      // Each scale spans the larger 5–95 % of the scanned and inferred parts (at least ±5 mm, the
+      // sensor's σ, and ±0.5 %, a sailcloth's stretch under load).
+      const DesignMoved& m = *r.moved;
+      double move = 0.005, stretch = 0.5;
+      for (const DistanceStats* s : {&m.normal_scanned, &m.normal_inferred})
+        if (s->count > 0) move = std::max({move, std::abs(s->p5_m), std::abs(s->p95_m)});
+      stretch = std::max({stretch, std::abs(m.fit.strain_supported.p5_pct), std::abs(m.fit.strain_supported.p95_pct)});
+      moved.normal_range_m = niceCeil(move * 1000) / 1000;
+      moved.stretch_range_pct = niceCeil(stretch);
+      moved.normal = renderColouredSide(m.fit.fitted, m.normal_m, moved.normal_range_m, m.inferred, rp.side);
+      moved.stretch = renderColouredSide(m.fit.fitted, m.stretch_pct, moved.stretch_range_pct, m.inferred, rp.side);
     }
   }
 
@@ -532,6 +670,7 @@ TrimReport writeTrimReport(const TrimReportParams& p, const Progress& progress) 
   } else {
     for (size_t i = 0; i < d.steps.size(); ++i) viewsPage(pdf, pages, d, d.steps[i], r.steps[i], views[i], range_m);
     for (size_t i = 0; i < d.steps.size(); ++i) tablePage(pdf, pages, d, d.steps[i], r.steps[i], r.design_outline);
+    if (r.moved) movedPage(pdf, pages, d, d.steps.back(), *r.moved, moved);
     plotsPage(pdf, pages, r, false);
     curvesPage(pdf, pages, r);
   }

@@ -15,6 +15,7 @@
 
 #include "analysis/core/progress.hpp"
 #include "analysis/design/design_compare.hpp"
+#include "analysis/fit/design_fit.hpp"
 #include "reports/pdf_document.hpp"
 #include "reports/render_views.hpp"
 #include "reports/report_data.hpp"
@@ -47,6 +48,18 @@ struct StepComparison {
   DistanceStats deviation;
 };
 
+// Where the design moved (issue 37): the design fitted onto the last step's stored surface,
+// each design vertex's move along the design's normal (+ to leeward), along the sail (the
+// move's part in the design's tangent plane) and the cloth's stretch there (the mean length
+// change of its edges, %), and whether samples held it or the fit carried it on from around.
+struct DesignMoved {
+  DesignFit fit;
+  std::vector<double> normal_m, along_m, stretch_pct;  // per design vertex
+  std::vector<char> inferred;                           // per design vertex: no sample within the support radius
+  DistanceStats normal_scanned, normal_inferred, along_scanned;
+  double inferred_sigma_p50_m = 0;
+};
+
 struct TrimReportData {
   ReportData data;
   SectionAnalysis design_sections;  // the design analysed at every fraction any step was cut at
@@ -55,6 +68,8 @@ struct TrimReportData {
   Summary summary;                  // of the last step
   std::vector<std::string> warnings;
   std::vector<std::string> notes;   // how the design was analysed (e.g. resampled)
+  // The last step's, when it stored its surface (the fit needs the scan's own shape, not a loft).
+  std::optional<DesignMoved> moved;
 };
 
 // Loads and compares without writing anything. Throws InvalidInput for bad

@@ -30,13 +30,38 @@ using namespace report_test;
 // cuts them), its gennaker tack eased 20 mm a step; the flying shape is the design
 // with `extra_camber_pct` more camber, stored with its reconstructed surface
 // (the generator's mesh of that shape over the whole sail) when `with_surface`.
+// The triangles of `mesh` below `top` of its height, with only the vertices they use.
+Mesh cutAbove(const Mesh& mesh, double top) {
+  double lo = 1e9, hi = -1e9;
+  for (const Vec3& v : mesh.vertices) lo = std::min(lo, v.z()), hi = std::max(hi, v.z());
+  const double cut = lo + top * (hi - lo) + 1e-9;
+  Mesh out;
+  std::vector<int64_t> index(mesh.vertices.size(), -1);
+  for (const auto& t : mesh.triangles) {
+    if (mesh.vertices[t[0]].z() > cut || mesh.vertices[t[1]].z() > cut || mesh.vertices[t[2]].z() > cut) continue;
+    std::array<uint32_t, 3> kept{};
+    for (int k = 0; k < 3; ++k) {
+      if (index[t[k]] < 0) {
+        index[t[k]] = static_cast<int64_t>(out.vertices.size());
+        out.vertices.push_back(mesh.vertices[t[k]]);
+      }
+      kept[k] = static_cast<uint32_t>(index[t[k]]);
+    }
+    out.triangles.push_back(kept);
+  }
+  return out;
+}
+
 struct SmallTest {
   TempDir dir;
   std::string db_path = dir.file("small.sailshape");
   SailDesign design;
 
+  // `surface_top`: the stored surface stops at this fraction of the sail's height (a scan that
+  // did not reach the head).
   SmallTest(SailType type, int steps, bool with_surface, double extra_camber_pct = 1.0,
-            const std::function<void(nlohmann::json&)>& edit = {}) : design(exampleDesign(type)) {
+            const std::function<void(nlohmann::json&)>& edit = {}, double surface_top = 1.0)
+      : design(exampleDesign(type)) {
     Database db = openSailDatabase(db_path);
     const Mesh mesh = generateSailMesh(design);
     upsertSail(db, {"A2", sailTypeName(type), "", "", "", "Demo 36"}, &mesh);
@@ -60,7 +85,7 @@ struct SmallTest {
       meta.side_n = -15;
       meta.heel_moment_nm = -17;
       meta.controls = {{"gennaker_tack_ease_m", 0.02 * k}};
-      const Mesh flying_mesh = generateSailMesh(flying);
+      const Mesh flying_mesh = cutAbove(generateSailMesh(flying), surface_top);
       importScan(db, meta, &doc, nullptr, {}, with_surface ? &flying_mesh : nullptr);
     }
   }
@@ -257,6 +282,60 @@ TEST(ReportPictures, TheFlyingSurfaceIsTheScannedSailNotALoftBetweenSections) {
   writeTrimReport(q);
   EXPECT_NE(pdfText(q.out_path).find("lofted"), std::string::npos);
   EXPECT_NE(pdfText(q.out_path).find("not stored"), std::string::npos);
+}
+
+// The designer's report fits the design onto the last step's stored surface: the page "Where the
+// design moved" shows each design point's move and the cloth's stretch, the part above the last
+// samples (a scan that stopped at 80 % of the height) drawn pale as inferred.
+TEST(ReportPictures, WhereTheDesignMovedFitsTheDesignAndTellsWhatWasInferred) {
+  const SmallTest t(SailType::Main, 1, true, 1.0, {}, 0.8);
+  const TrimReportData r = prepareTrimReport(t.params("unused.pdf"));
+  ASSERT_TRUE(r.moved.has_value());
+  const DesignMoved& m = *r.moved;
+  const Mesh& design = *r.data.design_mesh;
+  ASSERT_EQ(m.normal_m.size(), design.vertices.size());
+  SailDesign flying = t.design;
+  for (auto& s : flying.stations) s.camber_pct += 1.0;
+  const DesignDistance truth(generateSailMesh(flying, 160, 80));
+  double lo = 1e9, hi = -1e9;
+  for (const Vec3& v : design.vertices) lo = std::min(lo, v.z()), hi = std::max(hi, v.z());
+  // Below the cut (less a row of the design's mesh), the fit passes through the stored surface
+  // (an exact surface: no noise) and no vertex is inferred; well above it, all are.
+  double err2 = 0;
+  size_t below = 0, below_inferred = 0, above = 0, above_inferred = 0;
+  for (size_t v = 0; v < design.vertices.size(); ++v) {
+    const double h = (design.vertices[v].z() - lo) / (hi - lo);
+    if (h < 0.75) {
+      ++below;
+      below_inferred += m.inferred[v];
+      const double d = truth.signedDistance(m.fit.fitted.vertices[v]);
+      err2 += d * d;
+    } else if (h > 0.85) {
+      ++above;
+      above_inferred += m.inferred[v];
+    }
+  }
+  ASSERT_GT(below, 100u);
+  ASSERT_GT(above, 10u);
+  EXPECT_EQ(below_inferred, 0u);
+  EXPECT_EQ(above_inferred, above);
+  EXPECT_LT(std::sqrt(err2 / static_cast<double>(below)), 0.002);
+  // One percent more camber: the move along the normal where scanned is to leeward, mm to cm.
+  EXPECT_GT(m.normal_scanned.mean_m, 0.0);
+  EXPECT_LT(m.normal_scanned.max_abs_m, 0.1);
+
+  const TrimReportParams p = t.params("moved.pdf");
+  writeTrimReport(p);
+  const std::string text = pdfText(p.out_path);
+  EXPECT_NE(text.find("Where the design moved"), std::string::npos);
+  EXPECT_NE(text.find("Stretch of the cloth"), std::string::npos);
+  // The share drawn pale is the fit's own uncovered area.
+  EXPECT_NE(text.find("(" + std::to_string(static_cast<int>(std::lround(100 * (1 - m.fit.coverage)))) + " % of the area)"),
+            std::string::npos);
+  // For the crew the page is left out.
+  const TrimReportParams crew = t.params("crew.pdf", "crew");
+  writeTrimReport(crew);
+  EXPECT_EQ(pdfText(crew.out_path).find("Where the design moved"), std::string::npos);
 }
 
 // Step 1 flies the design, step 3 decimetres off it: every 3D page uses the one scale
