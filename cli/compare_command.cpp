@@ -54,12 +54,9 @@ struct WholeSail {
 WholeSail wholeSail(const Mesh& design, const std::vector<Vec3>& samples, const Vec3& leeward, const Progress& progress) {
   WholeSail w;
   w.fit = fitDesign(design, samples, {}, progress);
-  const std::vector<Vec3> normals = vertexNormals(design);
+  w.deviation_m = vertexMoves(design, w.fit, leeward).normal_m;
   std::vector<double> scanned, inferred, sigma;
-  w.deviation_m.resize(design.vertices.size());
   for (size_t v = 0; v < design.vertices.size(); ++v) {
-    const Vec3 n = normals[v].dot(leeward) < 0 ? Vec3(-normals[v]) : normals[v];
-    w.deviation_m[v] = w.fit.displacement_m[v].dot(n);
     if (w.fit.supported[v]) {
       scanned.push_back(w.deviation_m[v]);
     } else {

@@ -497,16 +497,13 @@ DesignMoved designMoved(const Mesh& design, const std::vector<Vec3>& surface, co
   DesignMoved m;
   m.fit = fitDesign(design, surface, {}, progress);
   const size_t n = design.vertices.size();
-  const std::vector<Vec3> normals = vertexNormals(design);
-  m.normal_m.resize(n);
-  m.along_m.resize(n);
+  VertexMoves moves = vertexMoves(design, m.fit, leeward);
+  m.normal_m = std::move(moves.normal_m);
+  m.along_m = std::move(moves.along_m);
+  m.stretch_pct = vertexStretchPct(m.fit);
   m.inferred.resize(n);
   std::vector<double> scanned, inferred, along, sigma;
   for (size_t v = 0; v < n; ++v) {
-    const Vec3 nv = normals[v].dot(leeward) < 0 ? Vec3(-normals[v]) : normals[v];
-    const Vec3& d = m.fit.displacement_m[v];
-    m.normal_m[v] = d.dot(nv);
-    m.along_m[v] = (d - m.normal_m[v] * nv).norm();
     m.inferred[v] = !m.fit.supported[v];
     if (m.inferred[v]) {
       inferred.push_back(m.normal_m[v]);
@@ -516,16 +513,6 @@ DesignMoved designMoved(const Mesh& design, const std::vector<Vec3>& surface, co
       along.push_back(m.along_m[v]);
     }
   }
-  // A vertex's stretch: the mean length change of the edges it ends.
-  m.stretch_pct.assign(n, 0.0);
-  std::vector<int> edges_at(n, 0);
-  for (size_t e = 0; e < m.fit.edges.size(); ++e)
-    for (uint32_t v : m.fit.edges[e]) {
-      m.stretch_pct[v] += m.fit.edge_strain_pct[e];
-      ++edges_at[v];
-    }
-  for (size_t v = 0; v < n; ++v)
-    if (edges_at[v] > 0) m.stretch_pct[v] /= edges_at[v];
   if (!scanned.empty()) m.normal_scanned = distanceStats(scanned);
   if (!inferred.empty()) m.normal_inferred = distanceStats(inferred);
   if (!along.empty()) m.along_scanned = distanceStats(along);

@@ -96,6 +96,10 @@ void App::drawDisplayOptions() {
   sameLineIfFits(checkboxWidth("design sections"));
   changed |= ImGui::Checkbox("design sections", &o.design_sections);
   changed |= ImGui::Checkbox("section planes", &o.section_planes);
+  changed |= ImGui::Checkbox("fitted design", &o.fitted);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("the design fitted to the scan: the whole sail, pale where the scan has no samples and the "
+                      "fit carried the shape on from around");
   changed |= ImGui::Checkbox("deviation colours", &o.deviation);
   if (o.deviation) {
     ImGui::SetNextItemWidth(widthBesideLabel("± mm", 140));

@@ -51,7 +51,7 @@ void writeState(const App& app, const std::string& path) {
 
 // --show design,surface,cluster,...: exactly these layers in the 3D view.
 ViewOptions shownLayers(ViewOptions o, const std::vector<std::string>& layers) {
-  o.design = o.surface = o.cloud = o.cluster = o.sections = o.design_sections = o.section_planes = false;
+  o.design = o.surface = o.cloud = o.cluster = o.sections = o.design_sections = o.section_planes = o.fitted = false;
   for (const std::string& l : layers) {
     if (l == "design") o.design = true;
     else if (l == "surface") o.surface = true;
@@ -60,7 +60,8 @@ ViewOptions shownLayers(ViewOptions o, const std::vector<std::string>& layers) {
     else if (l == "sections") o.sections = true;
     else if (l == "design-sections") o.design_sections = true;
     else if (l == "planes") o.section_planes = true;
-    else throw CLI::ValidationError("--show", "unknown layer '" + l + "' (design, surface, cloud, cluster, sections, design-sections, planes)");
+    else if (l == "fitted") o.fitted = true;
+    else throw CLI::ValidationError("--show", "unknown layer '" + l + "' (design, surface, cloud, cluster, sections, design-sections, planes, fitted)");
   }
   return o;
 }
@@ -317,8 +318,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   cli.add_option("--show", o.show,
                  "what the 3D view draws, comma-separated: design, surface, cloud, cluster (the sail points "
-                 "segmentation picked), sections, design-sections, planes (default: design, surface, sections, "
-                 "design-sections)")
+                 "segmentation picked), sections, design-sections, planes, fitted (the design fitted to the scan, "
+                 "pale where inferred) (default: design, surface, sections, design-sections)")
       ->delimiter(',');
   cli.add_option("--live", o.live,
                  "with --screenshot: add an emulated deck unit and run live mode (every sweep stored in the open "

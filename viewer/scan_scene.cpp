@@ -80,6 +80,11 @@ ScanScene buildScanScene(ScanRecord record, std::optional<Mesh> design, const Sc
       if (!scene.deviation) scene.deviation = distanceStats(scene.raw_deviation_m);
     }
     for (const auto& w : distance.warnings()) scene.warnings.push_back("design: " + w);
+    if (options.fit_design && !scene.surface.empty()) {
+      progress("fitting the design", 0.0);
+      scene.fitted = fitDesign(scene.design, scene.surface.vertices, {}, progress);
+      scene.fitted_move_m = vertexMoves(scene.design, *scene.fitted, distance.leeward()).normal_m;
+    }
   } catch (const Cancelled&) {
     throw;
   } catch (const std::exception& e) {

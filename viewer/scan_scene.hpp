@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "analysis/design/design_compare.hpp"
+#include "analysis/fit/design_fit.hpp"
 #include "analysis/pipeline/pipeline.hpp"
 #include "database/scan_record.hpp"
 #include "viewer/processing.hpp"
@@ -19,6 +20,7 @@ struct SceneOptions {
   AnalysisParams analysis;        // the pipeline's parameters for that run
   RoiBox roi;                     // the pipeline runs on the points inside (when enabled); the display keeps all
   bool design_sections = true;    // cut the design at the flying fractions (needed for the section table)
+  bool fit_design = true;         // fit the design onto the flying surface (the "fitted design" layer)
   size_t max_cloud_points = 300'000;  // the raw cloud is thinned (every k-th point) above this for display
 };
 
@@ -41,6 +43,11 @@ struct ScanScene {
   // sail_region.hpp designMismatch), for the viewer to show in red; empty when it
   // flies as its design could at a plausible trim, or without an analysis or design.
   std::string design_mismatch;
+  // The design fitted onto the flying surface (analysis/fit): the whole sail, where the scan reached
+  // and where the fit carried the shape on from around (fitted->supported); per design vertex its
+  // move along the design's normal, + to leeward. Empty without a design or a surface.
+  std::optional<DesignFit> fitted;
+  std::vector<double> fitted_move_m;
   std::vector<std::string> warnings;        // what could not be computed, and why
 };
 

@@ -97,6 +97,16 @@ nlohmann::json App::state() const {
     for (const UnmeasuredSection& u : s.sections.unmeasured)
       j["unmeasured_sections"].push_back({{"fraction", u.fraction}, {"reason", u.reason}});
     j["warnings"] = s.warnings;
+    // The design fitted to the scan: how much of it samples held, and its move along the normal.
+    j["fitted"] = nullptr;
+    if (s.fitted) {
+      size_t inferred = 0;
+      for (char supported : s.fitted->supported) inferred += supported ? 0 : 1;
+      j["fitted"] = {{"vertices", s.fitted->fitted.vertices.size()},
+                     {"inferred_vertices", inferred},
+                     {"coverage", s.fitted->coverage},
+                     {"rms_mm", 1000 * s.fitted->rms_m}};
+    }
   }
   if (pick_.info)
     j["pick"] = {{"what", pick_.info->what},

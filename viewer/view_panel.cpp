@@ -125,6 +125,13 @@ void App::drawViewCaptions(float origin_x, float origin_y, float w, float h) {
     if (!load_.scene->surface.empty() || !load_.scene->raw_cloud.empty())
       legend(kFlyingColour, load_.scene->record.scan_id ? "flying, scan " + std::to_string(load_.scene->record.scan_id)
                                                         : std::string("flying, not stored"));
+    if (view_.options.fitted && load_.scene->fitted) {
+      const DesignFit& f = *load_.scene->fitted;
+      legend(kFittedColour, "design fitted to the scan");
+      if (f.coverage < 1)
+        legend(kInferredColour, "pale: inferred, no sample (" + std::to_string(static_cast<int>(std::lround(100 * (1 - f.coverage)))) +
+                                    " % of the area)");
+    }
     for (const auto& ov : overlayList())
       legend(toU32(ov.colour), "step " + std::to_string(ov.scene->record.step) + ", scan " +
                                    std::to_string(ov.scene->record.scan_id));

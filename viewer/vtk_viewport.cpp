@@ -17,6 +17,7 @@
 #include <vtkNew.h>
 #include <vtkOpenGLFramebufferObject.h>
 #include <vtkPointData.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkPointPicker.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -43,6 +44,8 @@ constexpr Rgb kFlyingRed{0.86f, 0.13f, 0.10f};
 constexpr Rgb kSectionAmber{1.0f, 0.80f, 0.20f};
 constexpr Rgb kDesignSectionBlue{0.55f, 0.85f, 1.0f};
 constexpr Rgb kClusterGreen{0.20f, 0.90f, 0.50f};
+constexpr Rgb kFittedTeal{0.10f, 0.65f, 0.65f};
+constexpr double kPaleGrey = 0.80;  // what an inferred vertex of the fitted design is blended towards
 
 vtkSmartPointer<vtkPolyData> meshPoly(const Mesh& mesh) {
   auto poly = vtkSmartPointer<vtkPolyData>::New();
@@ -354,6 +357,32 @@ void VtkViewport::addSceneLayers(const ScanScene& scene, const ViewOptions& o) {
     m.add(a);
     m.picker->AddPickList(a);
     m.pickables.push_back({a, &scene.surface_deviation_m, "flying surface"});
+  }
+  if (o.fitted && scene.fitted && scene.fitted_move_m.size() == scene.fitted->fitted.vertices.size()) {
+    // The whole sail as the design fitted to the scan: teal, or its move along the design's normal
+    // in the deviation colours; where no sample held it (inferred), pale.
+    const DesignFit& f = *scene.fitted;
+    auto poly = meshPoly(f.fitted);
+    vtkNew<vtkUnsignedCharArray> colours;
+    colours->SetNumberOfComponents(3);
+    colours->SetName("fitted");
+    colours->SetNumberOfTuples(static_cast<vtkIdType>(f.fitted.vertices.size()));
+    for (size_t v = 0; v < f.fitted.vertices.size(); ++v) {
+      double c[3] = {kFittedTeal[0], kFittedTeal[1], kFittedTeal[2]};
+      if (dev) m.deviation_lut->GetColor(std::clamp(1000.0 * scene.fitted_move_m[v], -m.limit_mm, m.limit_mm), c);
+      if (!f.supported[v])
+        for (double& x : c) x = 0.75 * kPaleGrey + 0.25 * x;
+      for (int k = 0; k < 3; ++k) colours->SetComponent(static_cast<vtkIdType>(v), k, std::round(255 * c[k]));
+    }
+    poly->GetPointData()->SetScalars(colours);
+    auto a = actorOf(poly, kFittedTeal);
+    a->GetMapper()->SetScalarModeToUsePointData();
+    a->GetMapper()->SetColorModeToDirectScalars();
+    a->GetMapper()->ScalarVisibilityOn();
+    vtkPolyDataMapper::SafeDownCast(a->GetMapper())->SetRelativeCoincidentTopologyPolygonOffsetParameters(3, 3);
+    a->GetProperty()->SetAmbient(0.35);
+    a->PickableOff();
+    m.add(a);
   }
   if (o.cloud && !scene.raw_cloud.empty()) {
     auto poly = pointPoly(scene.raw_cloud.points);

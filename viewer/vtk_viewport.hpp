@@ -26,6 +26,7 @@ struct ViewOptions {
   bool sections = true;           // flying section curves
   bool design_sections = true;    // design section curves
   bool section_planes = false;    // translucent planes through each section
+  bool fitted = false;            // the design fitted onto the flying surface, the inferred part pale
   bool deviation = false;         // colour the flying shape by signed deviation (scalar bar shown)
   float deviation_range_mm = 0;   // ± limit of the colour map; 0: the 95th percentile of |deviation|
   float point_size = 2.0f;

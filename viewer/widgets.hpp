@@ -15,6 +15,8 @@ namespace sailshape::viewer {
 // The design's blue and the flying shape's red, as the 3D view draws them.
 constexpr ImU32 kDesignColour = IM_COL32(64, 140, 255, 255);
 constexpr ImU32 kFlyingColour = IM_COL32(220, 34, 26, 255);
+constexpr ImU32 kFittedColour = IM_COL32(26, 166, 166, 255);  // the fitted design layer (vtk_viewport's teal)
+constexpr ImU32 kInferredColour = IM_COL32(204, 204, 204, 255);  // its pale, inferred part
 inline const ImVec4 kErrorText{1.0f, 0.45f, 0.40f, 1.0f};
 inline const ImVec4 kMutedText{0.62f, 0.66f, 0.72f, 1.0f};
 inline const ImVec4 kAccentText{1.0f, 0.80f, 0.25f, 1.0f};

@@ -371,4 +371,34 @@ DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const 
   return out;
 }
 
+VertexMoves vertexMoves(const Mesh& design, const DesignFit& fit, const Vec3& leeward) {
+  if (fit.displacement_m.size() != design.vertices.size())
+    throw InvalidInput("[vertexMoves] a fit of " + std::to_string(fit.displacement_m.size()) + " vertices for a design of " +
+                       std::to_string(design.vertices.size()));
+  const std::vector<Vec3> normals = vertexNormals(design);
+  VertexMoves m;
+  m.normal_m.resize(normals.size());
+  m.along_m.resize(normals.size());
+  for (size_t v = 0; v < normals.size(); ++v) {
+    const Vec3 n = normals[v].dot(leeward) < 0 ? Vec3(-normals[v]) : normals[v];
+    const Vec3& d = fit.displacement_m[v];
+    m.normal_m[v] = d.dot(n);
+    m.along_m[v] = (d - m.normal_m[v] * n).norm();
+  }
+  return m;
+}
+
+std::vector<double> vertexStretchPct(const DesignFit& fit) {
+  std::vector<double> stretch(fit.fitted.vertices.size(), 0.0);
+  std::vector<int> edges_at(stretch.size(), 0);
+  for (size_t e = 0; e < fit.edges.size() && e < fit.edge_strain_pct.size(); ++e)
+    for (uint32_t v : fit.edges[e]) {
+      stretch[v] += fit.edge_strain_pct[e];
+      ++edges_at[v];
+    }
+  for (size_t v = 0; v < stretch.size(); ++v)
+    if (edges_at[v] > 0) stretch[v] /= edges_at[v];
+  return stretch;
+}
+
 }  // namespace sailshape

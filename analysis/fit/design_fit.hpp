@@ -90,4 +90,14 @@ struct DesignFit {
 DesignFit fitDesign(const Mesh& design, const std::vector<Vec3>& samples, const DesignFitParams& params = {},
                     const Progress& progress = {});
 
+// Per design vertex, how the fit moved it: along the design's normal turned towards `leeward`
+// (m, + to leeward) and the rest of its move, in the design's tangent plane (m, ≥ 0).
+struct VertexMoves {
+  std::vector<double> normal_m, along_m;
+};
+VertexMoves vertexMoves(const Mesh& design, const DesignFit& fit, const Vec3& leeward);
+
+// Per fitted vertex: the mean length change of the edges it ends, % (the cloth's stretch there).
+std::vector<double> vertexStretchPct(const DesignFit& fit);
+
 }  // namespace sailshape
