@@ -126,6 +126,32 @@ void placeCamera(vtkCamera* camera, View view, const std::vector<Vec3>& points, 
   camera->SetClippingRange(depth, 7 * depth);
 }
 
+// A smooth surface of `mesh` in per-vertex colours: `values` through deviationColour over
+// ±range, the vertices flagged in `muted` (when given) pale. Mostly ambient, so the colours
+// read as their legend with little shading. The actor's pipeline holds the surface.
+vtkNew<vtkActor> colouredActor(const Mesh& mesh, const std::vector<double>& values, double range,
+                               const std::vector<char>* muted) {
+  vtkNew<vtkPolyData> poly = surfaceOf(mesh);
+  vtkNew<vtkUnsignedCharArray> colours;
+  colours->SetNumberOfComponents(3);
+  colours->SetName("values");
+  colours->SetNumberOfTuples(static_cast<vtkIdType>(values.size()));
+  for (size_t i = 0; i < values.size(); ++i) {
+    Rgb c = deviationColour(values[i], range);
+    if (muted && (*muted)[i]) c = mutedColour(c);
+    for (int k = 0; k < 3; ++k) colours->SetComponent(static_cast<vtkIdType>(i), k, std::round(255 * c[k]));
+  }
+  poly->GetPointData()->SetScalars(colours);
+  vtkNew<vtkActor> actor = surfaceActor(poly);
+  actor->GetProperty()->SetAmbient(0.6);
+  actor->GetProperty()->SetDiffuse(0.4);
+  actor->GetProperty()->SetSpecular(0.0);
+  actor->GetMapper()->SetScalarModeToUsePointData();
+  actor->GetMapper()->SetColorModeToDirectScalars();
+  actor->GetMapper()->ScalarVisibilityOn();
+  return actor;
+}
+
 RgbImage capture(vtkRenderWindow* window) {
   window->Render();
   vtkNew<vtkWindowToImageFilter> grab;
@@ -214,23 +240,7 @@ SailViews renderSailViews(const Mesh& design, const Mesh& flying, const std::vec
   grid_actor->GetProperty()->SetLineWidth(1.0);
   grid_actor->GetProperty()->LightingOff();
 
-  vtkNew<vtkPolyData> coloured = surfaceOf(flying);
-  vtkNew<vtkUnsignedCharArray> colours;
-  colours->SetNumberOfComponents(3);
-  colours->SetName("deviation");
-  colours->SetNumberOfTuples(static_cast<vtkIdType>(deviation_m.size()));
-  for (size_t i = 0; i < deviation_m.size(); ++i) {
-    const Rgb c = deviationColour(deviation_m[i], p.deviation_range_m);
-    for (int k = 0; k < 3; ++k) colours->SetComponent(static_cast<vtkIdType>(i), k, std::round(255 * c[k]));
-  }
-  coloured->GetPointData()->SetScalars(colours);
-  vtkNew<vtkActor> deviation_actor = surfaceActor(coloured);
-  deviation_actor->GetProperty()->SetAmbient(0.6);  // colours read as the legend, little shading
-  deviation_actor->GetProperty()->SetDiffuse(0.4);
-  deviation_actor->GetProperty()->SetSpecular(0.0);
-  deviation_actor->GetMapper()->SetScalarModeToUsePointData();
-  deviation_actor->GetMapper()->SetColorModeToDirectScalars();
-  deviation_actor->GetMapper()->ScalarVisibilityOn();
+  vtkNew<vtkActor> deviation_actor = colouredActor(flying, deviation_m, p.deviation_range_m, nullptr);
 
   std::vector<Vec3> all = design.vertices;
   all.insert(all.end(), flying.vertices.begin(), flying.vertices.end());
@@ -279,24 +289,7 @@ RgbImage renderColouredSide(const Mesh& mesh, const std::vector<double>& values,
   if (size.width_px < 16 || size.height_px < 16 || size.width_px > 4096 || size.height_px > 4096)
     throw InvalidInput("[renderColouredSide] picture size must be 16..4096 px");
   const LeakCheckPause pause;
-  vtkNew<vtkPolyData> coloured = surfaceOf(mesh);
-  vtkNew<vtkUnsignedCharArray> colours;
-  colours->SetNumberOfComponents(3);
-  colours->SetName("values");
-  colours->SetNumberOfTuples(static_cast<vtkIdType>(values.size()));
-  for (size_t i = 0; i < values.size(); ++i) {
-    Rgb c = deviationColour(values[i], range);
-    if (muted[i]) c = mutedColour(c);
-    for (int k = 0; k < 3; ++k) colours->SetComponent(static_cast<vtkIdType>(i), k, std::round(255 * c[k]));
-  }
-  coloured->GetPointData()->SetScalars(colours);
-  vtkNew<vtkActor> actor = surfaceActor(coloured);
-  actor->GetProperty()->SetAmbient(0.6);
-  actor->GetProperty()->SetDiffuse(0.4);
-  actor->GetProperty()->SetSpecular(0.0);
-  actor->GetMapper()->SetScalarModeToUsePointData();
-  actor->GetMapper()->SetColorModeToDirectScalars();
-  actor->GetMapper()->ScalarVisibilityOn();
+  vtkNew<vtkActor> actor = colouredActor(mesh, values, range, &muted);
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1, 1, 1);
   renderer->AddActor(actor);
