@@ -249,9 +249,11 @@ void addAnalyzeCommand(CLI::App& app) {
                   "nearest the design, and a sail that flies farther from it than any plausible trim (RMS deviation "
                   "beyond a fifth of the mean chord, area beyond ±20 %, an edge beyond ±10 %) is a warning. When the scan "
                   "alone gives no sections (it did not reach the head or a clew: out of range, at grazing angles), "
-                  "the design is fitted onto the sail's samples (as `sailshape fit`): the corners the scan did not "
-                  "reach are the fitted design's, the sections are cut on the fitted surface, and each section says "
-                  "how much of it was inferred, its σ carrying the fit's");
+                  "or its luff or leech stops short of the design's by more than stretch and tension explain under a "
+                  "foot as long as the design's (a plain cloud or a crop that missed the head), the design is fitted "
+                  "onto the sail's samples (as `sailshape fit`): the corners the scan did not reach are the fitted "
+                  "design's, a section the scan spans between its own edges is measured on it, the others are cut on "
+                  "the fitted surface and say how much of them was inferred, their σ carrying the fit's");
   cmd->add_option("--fitted", opt->fitted_out,
                   "With --design, when the design was fitted in: write the fitted design (.ply, .obj or .stl), its "
                   "vertices and triangles in the design's order");
