@@ -333,12 +333,16 @@ MeshSections analyzeMeshSections(const Mesh& mesh, const OutlineParams& outline,
   r.notes.push_back("mesh resampled for the analysis: " + std::to_string(b.edges) + " boundary edges in " +
                     std::to_string(b.loops) + " loop(s); " + std::to_string(sampling.points) +
                     " uniform samples meshed again");
+  const Mesh resampled = resampleMesh(mesh, sampling);
+  r.outline = extractOutline(resampled, outline);
+  r.sections = cutSections(resampled, r.outline, sections);
+  return r;
+}
+
+Mesh resampleMesh(const Mesh& mesh, const MeshSampling& sampling) {
   SurfaceParams sp;
   sp.projection = "plane";
-  const Surface surface = reconstructSurface(sampleMesh(mesh, sampling.points, sampling.seed), sp);
-  r.outline = extractOutline(surface.mesh, outline);
-  r.sections = cutSections(surface.mesh, r.outline, sections);
-  return r;
+  return reconstructSurface(sampleMesh(mesh, sampling.points, sampling.seed), sp).mesh;
 }
 
 std::vector<SectionDelta> sectionDeltas(const SectionAnalysis& design, const SectionAnalysis& flying) {

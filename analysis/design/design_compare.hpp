@@ -87,6 +87,10 @@ struct MeshSampling {
   uint64_t seed = 1;
 };
 
+// The mesh sampled uniformly as `sampling` says (points, seed) and meshed again by the
+// pipeline's surface step, projected on its best-fit plane, as a clean scan would be.
+Mesh resampleMesh(const Mesh& mesh, const MeshSampling& sampling = {});
+
 // Outline and sections of a mesh (a design, or a flying shape given as a mesh).
 struct MeshSections {
   SailOutline outline;

@@ -11,7 +11,6 @@
 #include "analysis/fit/design_fit.hpp"
 #include "analysis/sections/luff_curve.hpp"
 #include "analysis/spatial/neighbours.hpp"
-#include "analysis/surface/surface.hpp"
 
 namespace sailshape {
 namespace {
@@ -19,7 +18,7 @@ namespace {
 constexpr double kDegPerRad = 180.0 / M_PI;
 
 // How far a flying sail's sections may differ from its design's where nothing was seen, 1σ:
-// a plausible trim (sail_region.hpp plausibleTrimDeviationM) changes the camber by up to ±5 %
+// a plausible trim (design_compare.hpp plausibleTrimDeviationM) changes the camber by up to ±5 %
 // of the chord and the twist by up to ±10° (sheeting and leech tension), here their 2σ. The
 // draft moves with the camber's change by a few % of the chord, and the end angles of a
 // parabolic section of camber c lie at atan(4c) to the chord: 4 × 2.5 % → 5.7°.
@@ -195,15 +194,12 @@ SailAnalysis analyzeWithDesign(const Cloud& scan, const RegionBox& region, const
   // The fitted design measured as a design is (analyzeMeshSections): sampled evenly and meshed
   // again, so a coarse export's facets do not become the sections' shape.
   progress("sections on the fitted design", 0.0);
-  const MeshSampling sampling;
-  SurfaceParams sp;
-  sp.projection = "plane";
-  const Surface fitted_surface = reconstructSurface(sampleMesh(fit.fitted, sampling.points, sampling.seed), sp);
+  const Mesh fitted_surface = resampleMesh(fit.fitted);
   OutlineParams op = params.outline;
   op.design_lengths_m.clear();  // the design's own: nothing to check
   op.beam_exit_diameter_m = op.beam_divergence_rad = 0;
   op.scanner_max_range_m = 0;
-  SailOutline o = extractOutline(fitted_surface.mesh, op);
+  SailOutline o = extractOutline(fitted_surface, op);
 
   // The scan's own outline, when the refusal came after it: the corners it reached stand
   // where it measured them.
@@ -308,7 +304,7 @@ SailAnalysis analyzeWithDesign(const Cloud& scan, const RegionBox& region, const
     std::nth_element(supported_sigma.begin(), supported_sigma.begin() + supported_sigma.size() / 2, supported_sigma.end());
     sections.surface_sigma_m = supported_sigma[supported_sigma.size() / 2];
   }
-  SectionAnalysis cut = cutSections(fitted_surface.mesh, o, sections);
+  SectionAnalysis cut = cutSections(fitted_surface, o, sections);
   for (Section& s : cut.sections) {
     auto scanned = std::find_if(on_scan.sections.begin(), on_scan.sections.end(),
                                 [&](const Section& x) { return std::abs(x.fraction - s.fraction) < 1e-9; });
@@ -322,11 +318,9 @@ SailAnalysis analyzeWithDesign(const Cloud& scan, const RegionBox& region, const
     addFitUncertainty(s, at, ds);
   }
   for (const std::string& w : on_scan.warnings) cut.warnings.push_back("on the scan's surface: " + w);
-  if (!cut.sections.empty()) {
-    const Section& low = cut.sections.front();
-    for (Section& s : cut.sections)
-      s.uncertainty.twist_rel_deg = &s == &low ? 0.0 : std::hypot(s.uncertainty.twist_deg, low.uncertainty.twist_deg);
-  }
+  // Sections from the scan's surface and from the fitted design, each relative to its own lowest:
+  // relative to the lowest of the mix now.
+  setTwistRelative(cut.sections);
 
   SailAnalysis a = std::move(partial);
   if (have_measured) o.coverage = measured.coverage;

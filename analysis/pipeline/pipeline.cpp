@@ -450,7 +450,6 @@ void measureSections(const AnalysisParams& p, SailAnalysis& a) {
   t.finish(a.sections.sections.size(), a.sections.warnings);
 }
 
-
 }  // namespace
 
 SectionParams sectionParamsFor(const AnalysisParams& p, const SailAnalysis& a) {

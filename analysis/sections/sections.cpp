@@ -858,18 +858,20 @@ SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const 
     for (const UnmeasuredSection& u : result.unmeasured) why += (why.empty() ? "" : "; ") + u.reason;
     throw AnalysisError("[cutSections] " + (result.unmeasured.size() == 1 ? why : "no section could be measured: " + why));
   }
-  {
-    const Section& low = result.sections.front();
-    if (!result.unmeasured.empty() && result.unmeasured.front().fraction < low.fraction)
-      result.warnings.push_back("twist_rel is relative to the lowest measured section, at fraction " +
-                                formatFixed(low.fraction, 3));
-    for (Section& s : result.sections) {
-      s.value.twist_rel_deg = s.value.twist_deg - low.value.twist_deg;
-      s.uncertainty.twist_rel_deg =
-          &s == &low ? 0.0 : std::hypot(s.uncertainty.twist_deg, low.uncertainty.twist_deg);
-    }
-  }
+  if (!result.unmeasured.empty() && result.unmeasured.front().fraction < result.sections.front().fraction)
+    result.warnings.push_back("twist_rel is relative to the lowest measured section, at fraction " +
+                              formatFixed(result.sections.front().fraction, 3));
+  setTwistRelative(result.sections);
   return result;
+}
+
+void setTwistRelative(std::vector<Section>& sections) {
+  if (sections.empty()) return;
+  const Section& low = sections.front();
+  for (Section& s : sections) {
+    s.value.twist_rel_deg = s.value.twist_deg - low.value.twist_deg;
+    s.uncertainty.twist_rel_deg = &s == &low ? 0.0 : std::hypot(s.uncertainty.twist_deg, low.uncertainty.twist_deg);
+  }
 }
 
 }  // namespace sailshape

@@ -99,6 +99,10 @@ void checkSectionParams(const SectionParams& params);
 // bad parameters and AnalysisError when no section can be measured.
 SectionAnalysis cutSections(const Mesh& mesh, const SailOutline& outline, const SectionParams& params = {});
 
+// Each section's twist_rel (value and σ) from its twist and the first's, the lowest: `sections`
+// ordered by fraction, as cutSections leaves them.
+void setTwistRelative(std::vector<Section>& sections);
+
 // Where the plane through `point` with unit `normal` cuts the mesh: polylines of
 // points on the mesh's edges, chained through the edges the cut triangles share
 // (open ones first, then loops). Each point lies on the curved edge the vertex

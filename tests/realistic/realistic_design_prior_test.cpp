@@ -180,6 +180,9 @@ TEST(RealisticDesignPrior, APlainCloudShortOfTheHeadIsToldByItsDesign) {
   for (const Section& s : a.sections.sections) std::printf("  section %.2f: %.0f %% inferred\n", s.fraction, s.inferred_pct);
   EXPECT_EQ(a.sections.sections.front().inferred_pct, 0.0);
   EXPECT_GT(a.sections.sections.back().inferred_pct, 50.0);
+  // Sections from the scan and from the fitted design, their twist_rel from the one lowest.
+  for (const Section& s : a.sections.sections)
+    EXPECT_DOUBLE_EQ(s.value.twist_rel_deg, s.value.twist_deg - a.sections.sections.front().value.twist_deg);
 }
 
 }  // namespace
