@@ -68,7 +68,8 @@ void printTable(const SailAnalysis& a) {
                 100 * cov.luff, 100 * cov.leech, 100 * cov.foot);
     if (o.has_peak) std::printf(", %.0f %% of the top", 100 * cov.top);
   } else if (!fitted) {
-    std::printf("\n  where the scan reached the sail's edges is not known: no scanner position (--viewpoint)");
+    std::printf("\n  where the scan reached the sail's edges is not known: no scanner position (--viewpoint), and the "
+                "samples' density did not tell it");
   }
   const LuffCurve& l = a.luff;
   std::printf("\n  luff curve: LUFA sag %.1f ± %.1f mm at %.0f ± %.0f %%, LUSW sag %.1f ± %.1f mm at %.0f ± %.0f %%\n\n",
@@ -240,7 +241,10 @@ void addAnalyzeCommand(CLI::App& app) {
                   "Where the scanner stood, X,Y,Z in metres in the cloud's frame, for a cloud that does not carry it "
                   "(a plain XYZ file; sailshape's own scans do): from it, a boundary the beams met at grazing "
                   "incidence or at the end of their range is told apart from the sail's edge, and a corner the scan "
-                  "never reached is refused rather than placed where the samples stop. Overrides the file's")
+                  "never reached is refused rather than placed where the samples stop. Overrides the file's. "
+                  "Without it (and without one in the file) the position is estimated from how the samples' density "
+                  "falls with range and obliquity (the warnings give it with its ±; estimate_viewpoint in "
+                  "--print-params turns that off)")
       ->expected(3)
       ->delimiter(',');
   cmd->add_option("--design", opt->design,

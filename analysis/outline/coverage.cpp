@@ -84,7 +84,7 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
   std::vector<BoundaryStop> stops(n);
   // The next sample out lies a boundary spacing further; ranges carry up to 0.3 % of
   // systematic error (SPEC §3).
-  const double range_margin = 2.0 * loop.spacing + 0.003 * p.scanner_max_range_m;
+  const double range_margin = 2.0 * loop.spacing + 0.003 * p.scanner_max_range_m + 2.0 * p.scanner_position_sigma_m;
   // The beams' angular spacing: the boundary's sample spacing over its range. The
   // scene's samples stand on the same grid of directions, so a beam just beyond the
   // boundary that met something nearer has a scene sample within a cell or two of it.
@@ -120,7 +120,8 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
     const double cosine = std::abs(ray.dot(normal)) / std::max(1e-12, s.range_m * normal.norm());
     s.incidence_deg = std::acos(std::min(1.0, cosine)) * kDegPerRad;
     if (p.scanner_max_range_m > 0 && s.range_m >= p.scanner_max_range_m - range_margin) s.stop = Stop::Range;
-    else if (s.incidence_deg >= p.grazing_incidence_deg) s.stop = Stop::Grazing;
+    else if (s.incidence_deg >= p.grazing_incidence_deg - 2.0 * p.scanner_position_sigma_m / s.range_m * kDegPerRad)
+      s.stop = Stop::Grazing;
     if (s.stop != Stop::Edge || scene.empty()) continue;
     // Two spacings beyond the boundary, outwards across it on the surface: the beam
     // there met something standing clear of the sail (ten spacings nearer the scanner,

@@ -201,6 +201,9 @@ void checkOutlineParams(const OutlineParams& p) {
   if (!(p.grazing_incidence_deg > 0 && p.grazing_incidence_deg <= 90))
     throw InvalidInput("[extractOutline] grazing_incidence_deg must be in (0, 90] (got " +
                        formatFixed(p.grazing_incidence_deg, 1) + ")");
+  if (!(p.scanner_position_sigma_m >= 0) || !std::isfinite(p.scanner_position_sigma_m))
+    throw InvalidInput("[extractOutline] scanner_position_sigma_m must be >= 0 (got " +
+                       formatFixed(p.scanner_position_sigma_m, 3) + ")");
   if (!(p.scanner_max_range_m >= 0) || !std::isfinite(p.scanner_max_range_m))
     throw InvalidInput("[extractOutline] scanner_max_range_m must be >= 0 (0: unknown; got " +
                        formatFixed(p.scanner_max_range_m, 1) + ")");

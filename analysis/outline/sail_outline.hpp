@@ -50,6 +50,11 @@ struct OutlineParams {
   // stopped, and a corner there was not reached.
   double grazing_incidence_deg = 70;
   double scanner_max_range_m = 0;
+  // 1σ of the scanner's position when it was estimated rather than known (m; 0:
+  // known). A boundary point r away then has its incidence uncertain by about σ/r
+  // rad and its range by σ: both limits above are met 2σ sooner, so that doubt
+  // about the scanner leans towards "the scan stopped here", never towards a corner.
+  double scanner_position_sigma_m = 0;
 };
 
 struct SailOutline {

@@ -83,6 +83,16 @@ nlohmann::json analysisToJson(const SailAnalysis& a) {
   } else {
     j["sail"]["coverage"] = nullptr;
   }
+  // Where the scanner stood when the cloud did not say and its density told it
+  // (the coverage above was read from there); null otherwise.
+  if (const auto& e = a.viewpoint_estimate) {
+    j["sail"]["scanner_estimate"] = {{"position", vec(e->position)},
+                                     {"sigma_m", vec(e->sigma_m)},
+                                     {"mirror_ambiguous", e->mirror_ambiguous},
+                                     {"beam_solid_angle_sr", e->beam_solid_angle_sr}};
+  } else {
+    j["sail"]["scanner_estimate"] = nullptr;
+  }
   // How far the edges were moved out for the scanner's beam footprint (0: not).
   j["sail"]["beam_footprint_m"] = o.footprint_reach_m;
   // 1σ: a corner's as the distance it may lie off, the rest in their own units.

@@ -31,11 +31,12 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SurfaceParams, projection, max_e
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(OutlineParams, corners, corner_window_m, min_fourth_corner_deg,
                                                 design_lengths_m, design_tolerance, design_warning,
                                                 beam_exit_diameter_m, beam_divergence_rad, edges_against_sky,
-                                                grazing_incidence_deg, scanner_max_range_m)
+                                                grazing_incidence_deg, scanner_max_range_m,
+                                                scanner_position_sigma_m)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SectionParams, count, fractions, plane, end_window, peak_window,
                                                 normal_tolerance_deg, max_tilt_deg, max_iterations, normal_radius,
                                                 noise_correlation_m, curve_points, max_bridged_gap)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, mixed_pixels, mixed, normals, segment,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AnalysisParams, sensor_sigma_m, mixed_pixels, mixed, estimate_viewpoint, normals, segment,
                                                 segmentation_voxel_sigmas, working_voxel_sigmas, working_column_depth_sigmas,
                                                 working_voxel_of_extent, region_growing,
                                                 sail_pick, find_spars, spars, statistical_outliers, statistical, radius_outliers, radius,
@@ -163,6 +164,7 @@ const std::map<std::string, ParamNote>& paramNotes() {
   static const std::map<std::string, ParamNote> notes = {
       {"sensor_sigma_m", {"m", "range noise of the scanner (1σ, SPEC §3); sets smoothing and uncertainties"}},
       {"mixed_pixels", {"-", "drop mixed pixels (beams straddling an edge) when the scan has its scan angles"}},
+      {"estimate_viewpoint", {"-", "a cloud without the scanner's position has it estimated from its samples' density"}},
       {"mixed.jump_sigmas", {"σ", "an edge: a range step off the slope beside it by more than this"}},
       {"mixed.max_incidence_deg", {"deg", "or, with no slope beside it, a step steeper than this incidence"}},
       {"mixed.max_run_rad", {"rad", "a run between two same-way edges no wider than this is mixed"}},
@@ -232,6 +234,8 @@ const std::map<std::string, ParamNote>& paramNotes() {
       {"outline.edges_against_sky", {"-", "open sky behind the edges (a scan on the water): no footprint shift"}},
       {"outline.grazing_incidence_deg", {"deg", "a boundary the beams meet beyond this incidence is where the scan stopped"}},
       {"outline.scanner_max_range_m", {"m", "the scanner's range; a boundary there is where the scan stopped (0: unknown)"}},
+      {"outline.scanner_position_sigma_m",
+       {"m", "1σ of an estimated scanner position: both limits above are met 2σ sooner (0: the position is known)"}},
       {"sections.count", {"-", "sections at t = k/(count+1) of luff and leech"}},
       {"sections.fractions", {"× luff", "explicit section heights in (0, 1); override count"}},
       {"sections.plane", {"-", "section plane: normal, perpendicular or horizontal"}},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <limits>
 #include <utility>
@@ -421,10 +422,35 @@ void meshSurface(const Cloud& cloud, const AnalysisParams& p, const Progress& pr
   t.finish(a.mesh.vertices.size(), s.warnings);
 }
 
+// Where the scanner stood: the cloud's viewpoint, else (p.estimate_viewpoint) the
+// position its samples' density tells, recorded in a.viewpoint_estimate.
+std::optional<Vec3> scannerPosition(const Cloud& cloud, const AnalysisParams& p, SailAnalysis& a) {
+  if (cloud.viewpoint || !p.estimate_viewpoint) return cloud.viewpoint;
+  StageTimer t(a, "scanner position", cloud.size());
+  std::string why;
+  a.viewpoint_estimate = estimateViewpoint(cloud, {}, &why);
+  std::vector<std::string> warnings;
+  char line[400];
+  if (const auto& e = a.viewpoint_estimate) {
+    std::snprintf(line, sizeof line,
+                  "the cloud does not say where the scanner stood: estimated from how its samples' density falls "
+                  "with range at (%.2f, %.2f, %.2f) ± (%.2f, %.2f, %.2f) m%s",
+                  e->position.x(), e->position.y(), e->position.z(), e->sigma_m.x(), e->sigma_m.y(), e->sigma_m.z(),
+                  e->mirror_ambiguous ? ", or its mirror image through the surfaces (shadows are not looked for)" : "");
+  } else {
+    std::snprintf(line, sizeof line, "the cloud does not say where the scanner stood, nor can it be estimated: %s",
+                  why.c_str());
+  }
+  warnings.emplace_back(line);
+  t.finish(cloud.size(), warnings);
+  return a.viewpoint_estimate ? std::optional<Vec3>(a.viewpoint_estimate->position) : std::nullopt;
+}
+
 // The outline stage: a.outline and a.luff from a.mesh, the corners read from the
 // `loose` points too. `sail_scan`: the sail's own samples when the sweep lost lines.
-void outlineSail(const Cloud& input, const Cloud& sail_scan, const std::vector<Vec3>& scan_points,
-                 const std::vector<Vec3>& scene, const AnalysisParams& p, SailAnalysis& a, std::vector<Vec3>& loose) {
+void outlineSail(const Cloud& input, const std::optional<Vec3>& scanner, const Cloud& sail_scan,
+                 const std::vector<Vec3>& scan_points, const std::vector<Vec3>& scene, const AnalysisParams& p,
+                 SailAnalysis& a, std::vector<Vec3>& loose) {
   StageTimer t(a, "outline", a.mesh.vertices.size());
   // A column mean at a narrow tip lies up to half a column short of the tip's outermost
   // samples: the corners read the scan's own points, at the scan's density.
@@ -436,7 +462,9 @@ void outlineSail(const Cloud& input, const Cloud& sail_scan, const std::vector<V
   // A scan that says which scanner took it tells where it ran out of range.
   OutlineParams op = p.outline;
   if (op.scanner_max_range_m == 0) op.scanner_max_range_m = input.scanner_range_m;
-  a.outline = extractOutline(a.mesh, op, loose, sample_density, input.viewpoint, scene);
+  if (a.viewpoint_estimate && !input.viewpoint)
+    op.scanner_position_sigma_m = std::max(op.scanner_position_sigma_m, a.viewpoint_estimate->sigma_m.norm());
+  a.outline = extractOutline(a.mesh, op, loose, sample_density, scanner, scene);
   for (std::string& w : widenCornersBesideLostLines(a.outline, sail_scan)) a.outline.warnings.push_back(std::move(w));
   a.luff = measureLuffCurve(a.outline);
   t.finish(a.outline.boundary.size(), a.outline.warnings);
@@ -510,9 +538,11 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
     cloud = selectPoints(cloud, c.kept);
     t.finish(cloud.size(), c.warnings);
   }
-  // What the scanner saw, for the shadows things in the way cast on the sail.
+  const std::optional<Vec3> scanner = scannerPosition(cloud, p, a);
+  // What the scanner saw, for the shadows things in the way cast on the sail; not
+  // when the scanner may have stood on the surfaces' other side.
   std::vector<Vec3> scene;
-  if (input.viewpoint) scene = cloud.points;
+  if (input.viewpoint || (a.viewpoint_estimate && !a.viewpoint_estimate->mirror_ambiguous)) scene = cloud.points;
   if (p.segment) segmentSail(cloud, p, progress, a);
 
   // The sail's own samples, with their scan angles, when the sweep lost lines: a
@@ -536,7 +566,7 @@ SailAnalysis analyzeSail(const Cloud& input, const AnalysisParams& p, const Prog
   meshSurface(cloud, p, progress, a, loose);
   bool outlined = false;
   try {
-    outlineSail(input, sail_scan, working.scan_points, scene, p, a, loose);
+    outlineSail(input, scanner, sail_scan, working.scan_points, scene, p, a, loose);
     outlined = true;
     measureSections(p, a);
     refuseImplausibleResults(a);

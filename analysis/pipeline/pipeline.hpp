@@ -17,6 +17,7 @@
 #include "analysis/segmentation/segmentation.hpp"
 #include "analysis/segmentation/spars.hpp"
 #include "analysis/spatial/normals.hpp"
+#include "analysis/spatial/viewpoint_estimate.hpp"
 #include "analysis/surface/smoothing.hpp"
 #include "analysis/surface/surface.hpp"
 
@@ -29,6 +30,10 @@ struct AnalysisParams {
   // the one above.
   bool mixed_pixels = true;
   MixedPixelParams mixed;
+  // A cloud without the scanner's position (plain XYZ) has it estimated from how its
+  // samples' density falls with range and obliquity (analysis/spatial/viewpoint_estimate.hpp),
+  // so the outline can still tell where the scan merely stopped from where the sail ends.
+  bool estimate_viewpoint = true;
   NormalParams normals;
   bool segment = true;             // false: the cloud is the sail alone, skip segmentation
   // Segmentation runs on a voxel-grid sample this many sensor σ wide when the
@@ -98,6 +103,9 @@ struct SailAnalysis {
   // alone refused, and the fit.
   std::string inferred_because;
   std::optional<DesignFit> design_fit;
+  // Where the scanner stood, estimated from the samples' density, when the cloud did not
+  // say (AnalysisParams::estimate_viewpoint); the outline's coverage was read from it.
+  std::optional<ViewpointEstimate> viewpoint_estimate;
 };
 
 // p.mixed with p's sensor σ.
