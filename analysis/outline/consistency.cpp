@@ -43,6 +43,17 @@ void refuseContradictoryOutline(const SailOutline& o) {
     if (lengths[i] >= total - lengths[i] && lengths[i] > 0)
       contradiction(std::string("its ") + names[i] + " (" + metres(lengths[i]) +
                     ") is as long as the other edges together (" + metres(total - lengths[i]) + ")");
+  // Each edge is a gently curved line between its corners: the most curved on any sail
+  // this product measures, a symmetric spinnaker's luff or leech, sags about a quarter
+  // of its chord and is some 15 % longer than it. One at least twice its corners' span
+  // runs round something else (a clew placed beside the tack, a head beside the clew).
+  const Vec3 top_end = o.has_peak ? o.peak : o.head;
+  const double chords[4] = {(o.head - o.tack).norm(), (top_end - o.clew).norm(), (o.clew - o.tack).norm(),
+                            o.has_peak ? (o.peak - o.head).norm() : 0.0};
+  for (int i = 0; i < 4; ++i)
+    if (lengths[i] > 0 && 2.0 * chords[i] < lengths[i])
+      contradiction(std::string("its ") + names[i] + " runs " + metres(lengths[i]) + " between corners " +
+                    metres(chords[i]) + " apart");
   // The luff runs from the tack up to the head: the sail's height, never shorter than
   // its foot on any sail this product measures (mains, headsails, spinnakers, code zeros).
   const double luff_chord = (o.head - o.tack).norm(), foot_chord = (o.clew - o.tack).norm();

@@ -63,5 +63,26 @@ TEST(RealisticViewpoint, APlainScansEstimateIsWithinItsSigmaOfTheUnit) {
   std::printf("estimated %zu of %zu\n", estimated, count);
 }
 
+// An asymmetric spinnaker scanned from the stern pulpit 16 m aft of its tack: the unit never
+// saw its clew. Read from the plain cloud's estimated scanner, the boundary is "scanned to the
+// edge" almost all round, and the outline names a point 0.9 m from the tack its clew, with a
+// 14.6 m foot between them (truth: a 13 m foot, the true clew 11.8 m from that point). No sail's edge runs
+// twice its corners' span: refused in one line.
+TEST(RealisticViewpoint, AClewPlacedBesideTheTackIsRefused) {
+  const Config config = drawConfig(629555642855503278ull);
+  ASSERT_EQ(config.sail, SailKind::AsymBow);
+  ASSERT_EQ(config.place, UnitPlace::SternPulpit);
+  const Scan scan = sweepScene(config, buildScene(config), 2);
+  try {
+    const SailAnalysis a = analyzeSail(plainXyz(scan.cloud));
+    FAIL() << "analysed: clew " << a.outline.clew.transpose() << ", foot " << a.outline.foot_length_m << " m";
+  } catch (const AnalysisError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the outline found is not a sail's: its foot runs "), std::string::npos) << what;
+    EXPECT_NE(what.find(" between corners "), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos);
+  }
+}
+
 }  // namespace
 }  // namespace sailshape::realistic
