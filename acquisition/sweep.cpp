@@ -249,7 +249,9 @@ Streamed streamSweep(TurntableClient& table, ScannerClient& scanner, const UnitC
   try {
     if (scanner.connected()) scanner.stop();
   } catch (const ScannerError& e) {
-    sweep.warnings.push_back(std::string("stop sequence: ") + e.what());
+    // A scanner that hung up streams to no one: only a stop refused or unanswered on a
+    // live connection leaves it streaming, and is worth a line.
+    if (scanner.connected()) sweep.warnings.push_back(std::string("stop sequence: ") + e.what());
   }
   if (!out.table_lost) {
     try {
