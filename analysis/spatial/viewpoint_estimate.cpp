@@ -175,7 +175,7 @@ Refined refine(const std::vector<Patch>& patches, const Vec3& start) {
   out.cov = (s2 * lu.inverse()).topLeftCorner<3, 3>();
   out.log_omega = c;
   out.objective = objective(c);
-  out.ok = out.v.allFinite() && out.cov.allFinite();
+  out.ok = out.v.allFinite() && out.cov.allFinite() && std::isfinite(c);
   return out;
 }
 
@@ -350,7 +350,7 @@ std::optional<ViewpointEstimate> estimateViewpoint(const Cloud& cloud, const Vie
   };
   if (cloud.size() < 10 * params.k_neighbours) return refuse("too few samples to read a density from");
   const std::vector<Patch> patches = samplePatches(cloud.points, params);
-  if (patches.size() < 50) return refuse("too few patches with a full disc of neighbours");
+  if (patches.size() < 50) return refuse("too few patches whose neighbours bound their sample's cell");
 
   // Coarse search over a box three times the cloud's size, centred on it: the
   // scanner may stand well outside a cropped cloud.
@@ -376,7 +376,7 @@ std::optional<ViewpointEstimate> estimateViewpoint(const Cloud& cloud, const Vie
       }
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
 
-  // Refine the best few distinct starts; keep the best and the best far from it.
+  // Refine the ten best starts that lie apart (the model has several basins).
   const double step = 1.5 * size / (kSteps - 1);
   std::vector<Refined> fits;
   std::vector<Vec3> starts;
