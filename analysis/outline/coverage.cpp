@@ -9,13 +9,12 @@
 // point the edges meet there is not the sail's corner.
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <string>
-#include <unordered_map>
 
 #include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
 #include "analysis/outline/outline_internal.hpp"
+#include "analysis/spatial/direction_map.hpp"
 
 namespace sailshape::outline_internal {
 namespace {
@@ -31,48 +30,6 @@ struct BoundaryStop {
   // beyond it, where the beams pass the thing in the way again and meet nothing of the
   // sail (0: no shadow), m.
   double bracket_m = 0;
-};
-
-// The scene as the scanner saw it: each point's direction from the scanner on a grid
-// of unit vectors `cell` radians wide, and the nearest range in each cell. A beam
-// towards direction u met nothing nearer than nearest(u) (within a cell each way).
-class DirectionMap {
- public:
-  DirectionMap(const std::vector<Vec3>& points, const Vec3& scanner, double cell) : cell_(cell) {
-    for (const Vec3& p : points) {
-      const Vec3 d = p - scanner;
-      const double r = d.norm();
-      if (r <= 0) continue;
-      auto [it, fresh] = nearest_.try_emplace(key(d / r), r);
-      if (!fresh) it->second = std::min(it->second, r);
-    }
-  }
-  // The nearest range among the cells around direction u (unit), or +∞.
-  double nearest(const Vec3& u) const {
-    double best = std::numeric_limits<double>::infinity();
-    const Eigen::Vector3i c = index(u);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          auto it = nearest_.find(pack(c + Eigen::Vector3i(dx, dy, dz)));
-          if (it != nearest_.end()) best = std::min(best, it->second);
-        }
-    return best;
-  }
-
- private:
-  Eigen::Vector3i index(const Vec3& u) const {
-    return Eigen::Vector3i(static_cast<int>(std::floor(u.x() / cell_)), static_cast<int>(std::floor(u.y() / cell_)),
-                           static_cast<int>(std::floor(u.z() / cell_)));
-  }
-  static uint64_t pack(const Eigen::Vector3i& i) {
-    auto part = [](int v) { return static_cast<uint64_t>(static_cast<uint32_t>(v + (1 << 20)) & 0x1fffff); };
-    return part(i.x()) | part(i.y()) << 21 | part(i.z()) << 42;
-  }
-  uint64_t key(const Vec3& u) const { return pack(index(u)); }
-
-  double cell_;
-  std::unordered_map<uint64_t, double> nearest_;
 };
 
 // Each loop point's incidence and range from the scanner, and why the samples stop there.

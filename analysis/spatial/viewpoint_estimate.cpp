@@ -5,9 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <unordered_map>
 
+#include "analysis/spatial/direction_map.hpp"
 #include "analysis/spatial/neighbours.hpp"
+#include "analysis/spatial/principal_axes.hpp"
 
 namespace sailshape {
 namespace {
@@ -56,11 +57,27 @@ double median(std::vector<double> v) {
   return v[mid];
 }
 
+// Each patch's residual about `v` before log Ω is taken off: modelLog − log ρ.
+std::vector<double> residualsAt(const std::vector<Patch>& patches, const Vec3& v) {
+  std::vector<double> a(patches.size());
+  for (size_t i = 0; i < patches.size(); ++i) a[i] = modelLog(patches[i], v, nullptr) - patches[i].log_density;
+  return a;
+}
+
+// The Cauchy objective Σ log(1 + ((a − log Ω)/scale)²) of residuals `a`.
+double cauchyObjective(const std::vector<double>& a, double log_omega, double scale) {
+  double f = 0;
+  for (double x : a) {
+    const double u = (x - log_omega) / scale;
+    f += std::log1p(u * u);
+  }
+  return f;
+}
+
 // Robust spread of the residuals about `v` (log Ω taken as their median):
 // the median absolute deviation, what the coarse search ranks positions by.
 double madCost(const std::vector<Patch>& patches, const Vec3& v) {
-  std::vector<double> a(patches.size());
-  for (size_t i = 0; i < patches.size(); ++i) a[i] = modelLog(patches[i], v, nullptr) - patches[i].log_density;
+  std::vector<double> a = residualsAt(patches, v);
   const double c = median(a);
   for (double& x : a) x = std::abs(x - c);
   return median(std::move(a));
@@ -95,15 +112,28 @@ Refined refine(const std::vector<Patch>& patches, const Vec3& start) {
     return std::sqrt(d2);
   };
   double c = 0;
-  auto objective = [&](double cc) {
-    double f = 0;
-    for (size_t i = 0; i < n; ++i) {
-      const double u = (a[i] - cc) / out.scale;
-      f += std::log1p(u * u);
-    }
-    return f;
-  };
+  auto objective = [&](double cc) { return cauchyObjective(a, cc, out.scale); };
+  // The Cauchy-weighted normal equations of (v, log Ω) at the residuals `a` (e = a − c):
+  // J = [∇modelLog, −1] per patch, weight 1/(1 + (e/scale)²).
   Eigen::Matrix4d normal;
+  Eigen::Vector4d rhs;
+  double sum_w = 0, sum_we2 = 0;
+  auto normalEquations = [&] {
+    normal.setZero();
+    rhs.setZero();
+    sum_w = sum_we2 = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double e = a[i] - c;
+      const double u = e / out.scale;
+      const double w = 1.0 / (1.0 + u * u);
+      Eigen::Vector4d j;
+      j << g[i], -1.0;
+      normal += w * j * j.transpose();
+      rhs -= w * e * j;
+      sum_w += w;
+      sum_we2 += w * e * e;
+    }
+  };
   for (int round = 0; round < 3; ++round) {
     residuals(out.v);
     c = median(a);
@@ -114,17 +144,7 @@ Refined refine(const std::vector<Patch>& patches, const Vec3& start) {
     double lambda = 1e-3;
     bool converged = false;
     for (int iter = 0; iter < 60 && !converged; ++iter) {
-      normal.setZero();
-      Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
-      for (size_t i = 0; i < n; ++i) {
-        const double e = a[i] - c;
-        const double u = e / out.scale;
-        const double w = 1.0 / (1.0 + u * u);
-        Eigen::Vector4d j;
-        j << g[i], -1.0;  // e = modelLog(v) − log ρ − c
-        normal += w * j * j.transpose();
-        rhs -= w * e * j;
-      }
+      normalEquations();
       const double max_step = 0.5 * nearestPatch(out.v);
       bool improved = false;
       for (int tries = 0; tries < 8 && !improved; ++tries) {
@@ -157,18 +177,7 @@ Refined refine(const std::vector<Patch>& patches, const Vec3& start) {
   }
   residuals(out.v);
   // The covariance of (v, log Ω) at the optimum, Ω's row and column marginalised out.
-  normal.setZero();
-  double sum_w = 0, sum_we2 = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const double e = a[i] - c;
-    const double u = e / out.scale;
-    const double w = 1.0 / (1.0 + u * u);
-    Eigen::Vector4d j;
-    j << g[i], -1.0;
-    normal += w * j * j.transpose();
-    sum_w += w;
-    sum_we2 += w * e * e;
-  }
+  normalEquations();
   const double s2 = sum_we2 / std::max(1.0, sum_w - 4.0);
   Eigen::FullPivLU<Eigen::Matrix4d> lu(normal);
   if (!lu.isInvertible()) return out;
@@ -229,17 +238,8 @@ std::vector<Patch> samplePatches(const std::vector<Vec3>& points, const Viewpoin
   for (size_t i = 0; i < points.size(); i += stride) {
     grid->nearest(points[i], k, idx, d2);
     if (idx.size() < k) continue;
-    Vec3 mean = Vec3::Zero();
-    for (uint32_t j : idx) mean += points[j];
-    mean /= static_cast<double>(k);
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (uint32_t j : idx) {
-      const Vec3 q = points[j] - mean;
-      cov += q * q.transpose();
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    const Vec3 normal = eig.eigenvectors().col(0);
-    const Vec3 e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
+    const PrincipalAxes plane = principalAxes(points, idx);
+    const Vec3 normal = plane.axes.col(0), e1 = plane.axes.col(2), e2 = plane.axes.col(1);
     tangent.clear();
     for (uint32_t j : idx) {
       if (j == i) continue;
@@ -286,12 +286,9 @@ Eigen::Matrix3d blockJackknife(const std::vector<Patch>& patches, const Vec3& v,
   return cov * (g - 1.0) / g;
 }
 
-// v refitted on the patches nearer than their median range from `v`, less v refitted
-// on the farther ones (zero when either refit fails).
-Vec3 rangeSplitDifference(const std::vector<Patch>& patches, const Vec3& v) {
-  std::vector<double> ranges;
-  for (const Patch& pa : patches) ranges.push_back((pa.p - v).norm());
-  const double mid = median(ranges);
+// v refitted on the patches nearer than `mid` (their median range) from `v`, less v
+// refitted on the farther ones (zero when either refit fails).
+Vec3 rangeSplitDifference(const std::vector<Patch>& patches, const Vec3& v, double mid) {
   std::vector<Patch> near, far;
   for (const Patch& pa : patches) ((pa.p - v).norm() < mid ? near : far).push_back(pa);
   if (near.size() < 50 || far.size() < 50) return Vec3::Zero();
@@ -307,35 +304,16 @@ Vec3 rangeSplitDifference(const std::vector<Patch>& patches, const Vec3& v) {
 // beam's angular spacing (`omega`, sr per beam) wide; a sample is behind when it
 // lies over 10 % (and 5 cm) further than the nearest in its cell or one beside it.
 size_t samplesBehind(const std::vector<Vec3>& points, const Vec3& v, double omega) {
-  const double cell = 2.0 * std::sqrt(std::max(omega, 1e-10));
   const size_t stride = std::max<size_t>(1, points.size() / 20000);
-  auto key = [cell](const Vec3& u, int dx, int dy, int dz) {
-    auto part = [](int x) { return static_cast<uint64_t>(static_cast<uint32_t>(x + (1 << 20)) & 0x1fffff); };
-    const int x = static_cast<int>(std::floor(u.x() / cell)) + dx, y = static_cast<int>(std::floor(u.y() / cell)) + dy,
-              z = static_cast<int>(std::floor(u.z() / cell)) + dz;
-    return part(x) | part(y) << 21 | part(z) << 42;
-  };
-  std::unordered_map<uint64_t, double> nearest;
-  for (size_t i = 0; i < points.size(); i += stride) {
-    const Vec3 d = points[i] - v;
-    const double r = d.norm();
-    if (!(r > 0)) continue;
-    auto [it, fresh] = nearest.try_emplace(key(d / r, 0, 0, 0), r);
-    if (!fresh) it->second = std::min(it->second, r);
-  }
+  std::vector<Vec3> sample;
+  for (size_t i = 0; i < points.size(); i += stride) sample.push_back(points[i]);
+  const DirectionMap seen(sample, v, 2.0 * std::sqrt(std::max(omega, 1e-10)));
   size_t behind = 0;
-  for (size_t i = 0; i < points.size(); i += stride) {
-    const Vec3 d = points[i] - v;
+  for (const Vec3& p : sample) {
+    const Vec3 d = p - v;
     const double r = d.norm();
     if (!(r > 0)) continue;
-    double first = r;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          auto it = nearest.find(key(d / r, dx, dy, dz));
-          if (it != nearest.end()) first = std::min(first, it->second);
-        }
-    if (r > 1.1 * first + 0.05) ++behind;
+    if (r > 1.1 * std::min(r, seen.nearest(d / r)) + 0.05) ++behind;
   }
   return behind;
 }
@@ -420,21 +398,11 @@ std::optional<ViewpointEstimate> estimateViewpoint(const Cloud& cloud, const Vie
       if (r.ok) fits.push_back(std::move(r));
     }
   }
-  // Objectives compared at one scale: that of the best start's fit.
-  auto objectiveAt = [&](const Refined& r, double scale) {
-    double f = 0;
-    std::vector<double> a(patches.size());
-    for (size_t i = 0; i < patches.size(); ++i) a[i] = modelLog(patches[i], r.v, nullptr) - patches[i].log_density;
-    for (double x : a) {
-      const double u = (x - r.log_omega) / scale;
-      f += std::log1p(u * u);
-    }
-    return f;
-  };
+  // Objectives compared at one scale: that of the narrowest fit's residuals.
   const double scale = std::min_element(fits.begin(), fits.end(), [](const Refined& x, const Refined& y) {
                          return x.scale < y.scale;
                        })->scale;
-  for (Refined& r : fits) r.objective = objectiveAt(r, scale);
+  for (Refined& r : fits) r.objective = cauchyObjective(residualsAt(patches, r.v), r.log_omega, scale);
   std::sort(fits.begin(), fits.end(), [](const Refined& x, const Refined& y) { return x.objective < y.objective; });
 
   // Neighbourhoods overlap: each sample sits in about patches·k/N of them, so the
@@ -477,15 +445,15 @@ std::optional<ViewpointEstimate> estimateViewpoint(const Cloud& cloud, const Vie
   // Where the model's bias grows with range (samples as close as the noise near the
   // unit, cells stretched far from it) the near and the far patches disagree on
   // where the unit stood; half their difference joins the σ.
-  const Vec3 split = rangeSplitDifference(patches, best.v);
+  std::vector<double> ranges;
+  for (const Patch& pa : patches) ranges.push_back((pa.p - best.v).norm());
+  e.median_range_m = median(ranges);
+  const Vec3 split = rangeSplitDifference(patches, best.v, e.median_range_m);
   e.sigma_m = ((overlap * best.cov.diagonal()).cwiseMax(0.0) + jack.diagonal().cwiseMax(0.0) + 0.25 * split.cwiseAbs2())
                   .cwiseSqrt();
   e.beam_solid_angle_sr = std::exp(best.log_omega);
   e.log_density_scatter = best.scale;
   e.patches = patches.size();
-  std::vector<double> ranges;
-  for (const Patch& pa : patches) ranges.push_back((pa.p - best.v).norm());
-  e.median_range_m = median(ranges);
   e.mirror_ambiguous = ambiguous;
   if (!(e.sigma_m.norm() <= params.max_relative_sigma * e.median_range_m)) {
     char detail[200];

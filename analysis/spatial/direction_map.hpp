@@ -1,0 +1,30 @@
+#pragma once
+// The scene as a scanner saw it: each point's direction from the scanner on a grid
+// of unit vectors `cell` radians wide, and the nearest range in each cell. A beam
+// towards direction u met nothing nearer than nearest(u) (within a cell each way).
+// What tells a shadow on a sail (analysis/outline/coverage.cpp) and a scanner's
+// mirror image (viewpoint_estimate.cpp).
+#include <Eigen/Core>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "analysis/core/cloud.hpp"
+
+namespace sailshape {
+
+class DirectionMap {
+ public:
+  DirectionMap(const std::vector<Vec3>& points, const Vec3& scanner, double cell);
+  // The nearest range among the cells around direction u (unit), or +∞.
+  double nearest(const Vec3& u) const;
+
+ private:
+  Eigen::Vector3i index(const Vec3& u) const;
+  static uint64_t pack(const Eigen::Vector3i& i);
+
+  double cell_;
+  std::unordered_map<uint64_t, double> nearest_;
+};
+
+}  // namespace sailshape
