@@ -56,7 +56,7 @@ void refuseContradictoryOutline(const SailOutline& o) {
                     metres(chords[i]) + " apart");
   // The luff runs from the tack up to the head: the sail's height, never shorter than
   // its foot on any sail this product measures (mains, headsails, spinnakers, code zeros).
-  const double luff_chord = (o.head - o.tack).norm(), foot_chord = (o.clew - o.tack).norm();
+  const double luff_chord = chords[0], foot_chord = chords[2];
   if (luff_chord < foot_chord)
     contradiction("the head lies " + metres(luff_chord) + " from the tack, nearer than the clew (" +
                   metres(foot_chord) + ")");

@@ -428,7 +428,9 @@ std::optional<Vec3> scannerPosition(const Cloud& cloud, const AnalysisParams& p,
   if (cloud.viewpoint || !p.estimate_viewpoint) return cloud.viewpoint;
   StageTimer t(a, "scanner position", cloud.size());
   std::string why;
-  a.viewpoint_estimate = estimateViewpoint(cloud, {}, &why);
+  ViewpointEstimateParams vp;
+  vp.sensor_sigma_m = p.sensor_sigma_m;
+  a.viewpoint_estimate = estimateViewpoint(cloud, vp, &why);
   std::vector<std::string> warnings;
   char line[400];
   if (const auto& e = a.viewpoint_estimate) {
@@ -462,7 +464,7 @@ void outlineSail(const Cloud& input, const std::optional<Vec3>& scanner, const C
   // A scan that says which scanner took it tells where it ran out of range.
   OutlineParams op = p.outline;
   if (op.scanner_max_range_m == 0) op.scanner_max_range_m = input.scanner_range_m;
-  if (a.viewpoint_estimate && !input.viewpoint)
+  if (a.viewpoint_estimate)
     op.scanner_position_sigma_m = std::max(op.scanner_position_sigma_m, a.viewpoint_estimate->sigma_m.norm());
   a.outline = extractOutline(a.mesh, op, loose, sample_density, scanner, scene);
   for (std::string& w : widenCornersBesideLostLines(a.outline, sail_scan)) a.outline.warnings.push_back(std::move(w));
