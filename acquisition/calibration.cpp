@@ -386,12 +386,4 @@ RangeScaleFit fitRangeScale(const std::vector<KnownSpan>& spans) {
   return fit;
 }
 
-Cloud removeRangeScale(const Cloud& cloud, double scale) {
-  if (!(scale > 0)) throw InvalidInput("[removeRangeScale] scale must be > 0 (got " + std::to_string(scale) + ")");
-  Cloud out = cloud;
-  const Vec3 o = cloud.viewpoint.value_or(Vec3::Zero());
-  for (Vec3& q : out.points) q = o + (q - o) / scale;
-  return out;
-}
-
 }  // namespace sailshape

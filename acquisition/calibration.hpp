@@ -95,9 +95,6 @@ struct RangeScaleFit {
 // from parallel.
 RangeScaleFit fitRangeScale(const std::vector<KnownSpan>& spans);
 
-// The cloud with the range scale taken out: every point pulled towards the
-// cloud's viewpoint (the origin without one) by 1 / scale. Throws InvalidInput
-// for a scale ≤ 0.
-Cloud removeRangeScale(const Cloud& cloud, double scale);
+// removeRangeScale (analysis/registration/rigid_transform.hpp) applies a fitted scale.
 
 }  // namespace sailshape

@@ -295,6 +295,12 @@ void validateDemoOptions(const DemoOptions& o) {
 }
 
 // What every trim step shares, set up once: the output folders, the rig and what the crew measured of the tunnel.
+// A unit's registration into the boat frame as the steps use it.
+struct StoredRegistration {
+  RigidTransform transform;  // scanner to boat frame, for the cloud with the range scale taken out
+  double range_scale = 1, range_scale_sigma = 0;
+};
+
 struct DemoRun {
   DemoOptions options;
   DemoLog log;
@@ -307,7 +313,8 @@ struct DemoRun {
   std::vector<Spar> spars;  // where the crew measured them, boat frame
   std::string session;
   EmulatedTurntableParams turntable;
-  std::vector<std::optional<RigidTransform>> stored;  // per unit: its registration until it moves
+  // Per unit: its registration, kept until it moves.
+  std::vector<std::optional<StoredRegistration>> stored;
   DemoResult result;
 };
 
@@ -334,13 +341,15 @@ void writeUnitFiles(DemoRun& run) {
 }
 
 // What the emulator really did, to check the demo's results against: where each
-// unit stood (4×4 row-major, scanner to boat frame, as the database's registrations).
+// unit stood (4×4 row-major, scanner to boat frame, as the database's registrations)
+// and its systematic range error as a range scale (measured / true range).
 void writeEmulatorTruth(const DemoRun& run) {
   json units = json::array();
   for (const RigUnit& u : run.rig) {
     json rows = json::array();
     for (int r = 0; r < 4; ++r) rows.push_back({u.true_pose(r, 0), u.true_pose(r, 1), u.true_pose(r, 2), u.true_pose(r, 3)});
-    units.push_back({{"name", u.config.name}, {"sail", u.sail}, {"true_pose", rows}});
+    const double scale = 1 + EmulatedUnit::emulatorParams(u, 0).sensor.systematic_fraction;
+    units.push_back({{"name", u.config.name}, {"sail", u.sail}, {"true_pose", rows}, {"range_scale", scale}});
   }
   std::ofstream(fs::path(run.options.dir) / "emulator-truth.json") << json{{"units", units}}.dump(2) << "\n";
 }
@@ -361,7 +370,7 @@ void storeDesigns(Database& db, const std::vector<RigUnit>& rig) {
 struct UnitStep {
   DemoUnitStep row;
   BoatRegistration registration;
-  RigidTransform used;  // scanner to boat frame: the stored registration
+  StoredRegistration used;  // the unit's stored registration
   Cloud boat_cloud;
   RegionBox region;  // the sail's region in the boat frame, stored with the scan
   std::optional<SailAnalysis> analysis;  // empty when the analysis failed
@@ -402,29 +411,28 @@ void registerOnWalls(DemoRun& run, size_t i, const Sweep& sweep, const std::stri
   if (!reg.accepted)
     run.result.warnings.push_back({out.row.step, u.config.name + ": wall registration not accepted (fitness " +
                                                      std::to_string(1000 * reg.fitness_rms_m) + " mm)"});
-  std::optional<RigidTransform>& stored = run.stored[i];
+  std::optional<StoredRegistration>& stored = run.stored[i];
+  const StoredRegistration fresh{reg.transform, reg.range_scale, reg.range_scale_sigma};
   if (!stored) {
-    stored = reg.transform;
+    stored = fresh;
   } else {
-    // Registrations of an unmoved unit differ by the sensor's σ-level fitness plus the
-    // range's systematic error (SPEC §3: up to 0.3 % of range) on whichever walls carry
-    // them: two fits leaning on different walls differ by up to that over the farthest.
-    double farthest_m = 0;
-    for (const ReferenceFace& f : run.walls.faces)
-      farthest_m = std::max(farthest_m, std::abs(f.normal.dot(u.config.pose.translation()) - f.offset_m));
-    const double tolerance_m = 0.009 + 0.003 * farthest_m;
-    const Drift d = compareTransforms(*stored, reg.transform, 5.0, tolerance_m);
+    // With the range scale fitted alongside, an unmoved unit's registrations on the
+    // walls agree to a fraction of the sensor's random error (their 10⁵ points
+    // average it out; the scale no longer shifts each wall by up to 0.3 % of its
+    // range): a displacement beyond one σ (SPEC §3) anywhere within 5 m is a move.
+    const double tolerance_m = AnalysisParams{}.sensor_sigma_m;
+    const Drift d = compareTransforms(stored->transform, reg.transform, 5.0, tolerance_m);
     row.drift_mm = 1000 * d.max_displacement_m;
     if (d.moved) {
       run.result.warnings.push_back(
           {row.step, u.config.name + ": the unit moved (" + std::to_string(row.drift_mm) + " mm); registered again"});
-      stored = reg.transform;
+      stored = fresh;
     }
   }
   out.used = *stored;
   row.registration_rms_mm = 1000 * reg.fitness_rms_m;
-  row.truth_error_deg = rotationDifferenceDeg(out.used.linear(), u.true_pose.linear());
-  row.truth_error_mm = 1000 * (out.used.translation() - u.true_pose.translation()).norm();
+  row.truth_error_deg = rotationDifferenceDeg(out.used.transform.linear(), u.true_pose.linear());
+  row.truth_error_mm = 1000 * (out.used.transform.translation() - u.true_pose.translation()).norm();
 }
 
 // The spars where this cloud has them: the registration is good to a couple of
@@ -459,7 +467,7 @@ void analyseUnit(DemoRun& run, size_t i, int step, const Sweep& sweep, const std
   const RigUnit& u = run.rig[i];
   DemoUnitStep& row = out.row;
   run.log(tag + ": " + u.config.name + ": analysing " + u.sail);
-  out.boat_cloud = transformCloud(sweep.cloud, out.used);
+  out.boat_cloud = toBoatFrame(sweep.cloud, out.used.transform, out.used.range_scale);
   AnalysisParams ap;
   ap.sections = run.sections;
   // The unit's beam footprint trims every edge (1.5-4 cm at these ranges); the outline allows for it.
@@ -548,6 +556,9 @@ void storeStep(DemoRun& run, Database& db, int step, const std::string& tag, con
     m.scanned_at = isoNow();
     m.settings = json::parse(unitToJson(u.config));
     m.settings["forces"] = "simulated by the emulator (not measured)";
+    m.settings["range_scale"] = {{"scale", us.used.range_scale},
+                                 {"sigma", us.used.range_scale_sigma},
+                                 {"applied", "taken out of the cloud before the registration's transform"}};
     m.settings["sweep"] = {{"scans", sweeps[i].scans},
                            {"beams", sweeps[i].beams},
                            {"partial", sweeps[i].partial},
@@ -557,7 +568,7 @@ void storeStep(DemoRun& run, Database& db, int step, const std::string& tag, con
     const json doc = us.analysis ? analysisToJson(*us.analysis) : json();
     const ImportResult r =
         importScan(db, m, us.analysis ? &doc : nullptr, &us.boat_cloud, {}, us.analysis ? &us.analysis->mesh : nullptr);
-    addRegistration(db, r.scan_id, us.used.matrix(), us.registration.fitness_rms_m, us.registration.fitness_rms_m);
+    addRegistration(db, r.scan_id, us.used.transform.matrix(), us.registration.fitness_rms_m, us.registration.fitness_rms_m);
     us.row.scan_id = r.scan_id;
     run.result.scans.push_back(us.row);
     if (!us.analysis) continue;

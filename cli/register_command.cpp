@@ -50,9 +50,11 @@ void printSummary(const char* what, const RigidTransform& t) {
                t.translation().y(), t.translation().z());
 }
 
-void writeApplied(const RegisterOptions& o, const std::string& source, const RigidTransform& t) {
+// `range_scale`: the source unit's, taken out before the transform (the boat
+// registration fits it for the reference cloud; 1 for a moving cloud).
+void writeApplied(const RegisterOptions& o, const std::string& source, const RigidTransform& t, double range_scale = 1) {
   const CloudReadResult in = readCloud(source);
-  writeCloud(o.apply, transformCloud(in.cloud, t));
+  writeCloud(o.apply, toBoatFrame(in.cloud, t, range_scale));
   if (!o.quiet) std::fprintf(stderr, "wrote %s: %zu points of %s transformed\n", o.apply.c_str(), in.cloud.size(), source.c_str());
 }
 
@@ -85,6 +87,7 @@ void run(const RegisterOptions& o) {
   RigidTransform result = RigidTransform::Identity();  // what --out stores
   bool accepted = true;
   std::string why;
+  double reference_range_scale = 1;  // taken out of the reference cloud by --apply (boat registration only)
 
   if (!o.moving.empty()) {
     const Cloud moving = readCloud(o.moving).cloud;
@@ -161,6 +164,8 @@ void run(const RegisterOptions& o) {
                          {"fitness_rms_m", b.fitness_rms_m},
                          {"below_uncertainty", b.below_uncertainty},
                          {"ambiguous", b.ambiguous},
+                         {"range_scale", b.range_scale},
+                         {"range_scale_sigma", b.range_scale_sigma},
                          {"accepted", b.accepted},
                          {"faces", nlohmann::json::array()},
                          {"warnings", b.warnings}};
@@ -170,6 +175,7 @@ void run(const RegisterOptions& o) {
     doc["boat"] = bj;
     // moving → reference → boat, or the reference itself → boat.
     result = b.transform * result;
+    if (o.moving.empty()) reference_range_scale = b.range_scale;
     if (!o.moving.empty()) describe(doc["moving_to_boat"], result);
     if (!b.accepted) {
       accepted = false;
@@ -180,6 +186,11 @@ void run(const RegisterOptions& o) {
       printSummary("reference → boat", b.transform);
       std::fprintf(stderr, "boat frame: %zu planes on faces of '%s', %.2f mm RMS, %s\n", b.faces.size(),
                    boat.name.c_str(), b.fitness_rms_m * 1000, b.accepted ? "accepted" : "NOT accepted");
+      std::fprintf(stderr,
+                   "range scale of the reference unit %.5f ± %.5f (systematic range error %+.3f %%), taken out before "
+                   "the transform by --apply%s\n",
+                   b.range_scale, b.range_scale_sigma, 100 * (b.range_scale - 1),
+                   o.moving.empty() ? "" : " on the reference only (the moving unit's is not measured here)");
       for (const auto& w : b.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     }
   }
@@ -211,7 +222,7 @@ void run(const RegisterOptions& o) {
     writeTransform(o.out, result);
     if (!o.quiet) std::fprintf(stderr, "wrote %s\n", o.out.c_str());
   }
-  if (!o.apply.empty()) writeApplied(o, o.moving.empty() ? o.reference : o.moving, result);
+  if (!o.apply.empty()) writeApplied(o, o.moving.empty() ? o.reference : o.moving, result, reference_range_scale);
 }
 
 }  // namespace
@@ -251,8 +262,10 @@ void addRegisterCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--boat-reference", opt->boat_reference,
                   "JSON file of faces known in boat coordinates (a cube on the deck, tunnel walls; see "
-                  "analysis/registration/boat_registration.hpp): registers the reference cloud to the boat frame; with --moving "
-                  "the stored transform maps the moving cloud into the boat frame");
+                  "analysis/registration/boat_registration.hpp): registers the reference cloud to the boat frame, fitting the "
+                  "unit's range scale (its systematic range error) with the pose where faces of known separation fix it "
+                  "(floor and ceiling, two side walls); --apply takes the scale out; with --moving the stored transform "
+                  "maps the moving cloud into the boat frame");
   cmd->add_option("--out", opt->out, "Write the 4x4 transform here (four lines of four numbers)");
   cmd->add_option("--apply", opt->apply, "Write the moving cloud (or the reference, without --moving) transformed");
   cmd->add_option("--json", opt->json_out,

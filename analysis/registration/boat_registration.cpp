@@ -126,6 +126,7 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
   if (!(p.max_face_distance_m > 0)) bad("max_face_distance_m must be > 0");
   if (!(p.uncertainty_m > 0)) bad("uncertainty_m must be > 0");
   if (p.refine_iterations < 0) bad("refine_iterations must be >= 0");
+  if (!(p.range_scale_prior_sigma >= 0)) bad("range_scale_prior_sigma must be >= 0");
   const auto& F = ref.faces;
   auto usable = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
     return lineAngleDeg(a, b) >= p.min_plane_angle_deg && lineAngleDeg(a, c) >= p.min_plane_angle_deg &&
@@ -212,53 +213,86 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
                            "narrow prior_tolerance_deg or add a face that breaks the symmetry");
   RigidTransform t = candidates[chosen].t;
 
-  // Fit every matched plane's points onto its face (linearised, few iterations).
+  // Fit every matched plane's points onto its face (linearised, few iterations),
+  // with the unit's range scale k: a point p (unit frame, viewpoint v) truly lies
+  // at t·(v + c(p − v)), c = 1/k. Unknowns: a small turn ω and shift τ (applied
+  // after t) and δc; a point's residual r = n·x − d moves by (x × n)·ω + n·τ +
+  // n·R(p − v)·δc. The prior on c − 1 is weighted by the residual variance, so
+  // that it enters the normal equations on the points' scale.
+  const bool fit_scale = p.range_scale_prior_sigma > 0;
+  const Vec3 v = cloud.viewpoint.value_or(Vec3::Zero());
+  double c = 1;
+  Eigen::Matrix<double, 7, 7> ata_final = Eigen::Matrix<double, 7, 7>::Zero();
+  double variance = 0;
   progress("boat frame", 0.5);
   for (int it = 0; it <= p.refine_iterations; ++it) {
     const std::vector<size_t> on = facesOf(D, ref, t, 2 * tol, p.max_face_distance_m);
-    Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix<double, 7, 7> ata = Eigen::Matrix<double, 7, 7>::Zero();
+    Eigen::Matrix<double, 7, 1> atb = Eigen::Matrix<double, 7, 1>::Zero();
     out.faces.clear();
     double total2 = 0;
     size_t total = 0;
-    for (size_t k = 0; k < D.size(); ++k) {
-      if (on[k] == F.size()) continue;
-      const ReferenceFace& f = F[on[k]];
-      FaceMatch fm{f.name, k, D[k].points, 0, angleDeg(t.linear() * D[k].normal, f.normal)};
+    for (size_t j = 0; j < D.size(); ++j) {
+      if (on[j] == F.size()) continue;
+      const ReferenceFace& f = F[on[j]];
+      FaceMatch fm{f.name, j, D[j].points, 0, angleDeg(t.linear() * D[j].normal, f.normal)};
       double sum2 = 0;
-      for (uint32_t i : D[k].indices) {
-        const Vec3 x = t * cloud.points[i];
+      for (uint32_t i : D[j].indices) {
+        const Vec3& q = cloud.points[i];
+        const Vec3 x = t * (v + c * (q - v));
         const double r = f.normal.dot(x) - f.offset_m;
-        Eigen::Matrix<double, 6, 1> a;
-        a << x.cross(f.normal), f.normal;
+        // The derivatives at the point's place on its plane, not at its noisy
+        // sample: where the faces leave the scale to trade with the translation,
+        // derivatives holding the sample's own noise would fit the scale to it
+        // (the residual regressed on itself pulls c towards 0).
+        const Vec3 q_plane = q - (D[j].normal.dot(q) - D[j].offset_m) * D[j].normal;
+        const Vec3 x_plane = t * (v + c * (q_plane - v));
+        Eigen::Matrix<double, 7, 1> a;
+        a << x_plane.cross(f.normal), f.normal, f.normal.dot(t.linear() * (q_plane - v));
         ata += a * a.transpose();
         atb -= a * r;
         sum2 += r * r;
       }
-      fm.rms_m = std::sqrt(sum2 / static_cast<double>(D[k].indices.size()));
+      fm.rms_m = std::sqrt(sum2 / static_cast<double>(D[j].indices.size()));
       total2 += sum2;
-      total += D[k].indices.size();
+      total += D[j].indices.size();
       out.faces.push_back(fm);
     }
     out.fitness_rms_m = total ? std::sqrt(total2 / static_cast<double>(total)) : 0.0;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(ata);
+    variance = total > 7 ? total2 / static_cast<double>(total - 7) : 0.0;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(ata.topLeftCorner<6, 6>());
     const bool constrained = total > 0 && es.eigenvalues()(0) >= 1e-9 * es.eigenvalues()(5);
     if (!constrained) {
       out.warnings.push_back("the matched faces do not fix all six degrees of freedom; the transform comes from the "
                              "plane intersection alone");
       break;
     }
+    if (fit_scale) {
+      const double w = std::max(variance, 1e-12) / (p.range_scale_prior_sigma * p.range_scale_prior_sigma);
+      ata(6, 6) += w;
+      atb(6) -= w * (c - 1);
+    } else {  // δc = 0
+      ata.row(6).setZero();
+      ata.col(6).setZero();
+      ata(6, 6) = 1;
+      atb(6) = 0;
+    }
+    ata_final = ata;
     if (it == p.refine_iterations) {
       out.accepted = true;  // provisional: constrained
       break;
     }
-    const Eigen::Matrix<double, 6, 1> x = ata.ldlt().solve(atb);
+    const Eigen::Matrix<double, 7, 1> x = ata.ldlt().solve(atb);
     RigidTransform step = RigidTransform::Identity();
     const Vec3 w = x.head<3>();
     if (w.norm() > 0) step.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
-    step.translation() = x.tail<3>();
+    step.translation() = x.segment<3>(3);
     t = step * t;
+    c += x(6);
   }
+  // k = 1/c: σ_k = σ_c / c².
+  out.range_scale = 1 / c;
+  if (fit_scale && out.accepted) out.range_scale_sigma = std::sqrt(variance * ata_final.inverse()(6, 6)) / (c * c);
   progress("boat frame", 1.0);
   out.transform = t;
   out.below_uncertainty = out.fitness_rms_m <= p.uncertainty_m;
@@ -267,6 +301,10 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
                            formatFixed(p.uncertainty_m * 1000, 1) + " mm uncertainty");
   out.accepted = out.accepted && out.below_uncertainty && !out.ambiguous;
   return out;
+}
+
+Cloud toBoatFrame(const Cloud& cloud, const RigidTransform& transform, double range_scale) {
+  return transformCloud(removeRangeScale(cloud, range_scale), transform);
 }
 
 }  // namespace sailshape

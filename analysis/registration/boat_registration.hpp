@@ -59,6 +59,13 @@ struct BoatRegistrationParams {
   double prior_tolerance_deg = 180.0;  // 180: no prior
   double uncertainty_m = 0.009;        // SPEC §4 step 4, model scale
   int refine_iterations = 10;
+  // The unit's range scale k (measured range / true range, SPEC §3's systematic
+  // error: up to ≈ 0.3 % of range) is fitted with the pose: faces of known
+  // separation seen from one unit (a tunnel's floor and ceiling, its two side
+  // walls) fix it, since a scaled scene stands k·D between them. This prior σ on
+  // k − 1 holds it at 1 where the faces seen cannot (one face of each
+  // direction: the scale trades against the translation); 0: no scale fitted.
+  double range_scale_prior_sigma = 0.003;
 };
 
 struct FaceMatch {
@@ -74,6 +81,10 @@ struct BoatRegistration {
   std::vector<FaceMatch> faces;  // every plane that lies on a face
   size_t planes = 0;             // detected in the cloud
   double fitness_rms_m = 0;      // matched planes' points to their faces, m
+  // The unit's range scale fitted with the pose, and its σ (the prior's when the
+  // faces do not fix it). The transform applies to the cloud with the scale
+  // taken out: toBoatFrame.
+  double range_scale = 1, range_scale_sigma = 0;
   bool below_uncertainty = false;
   bool ambiguous = false;        // another match explains as much (a symmetric object without a prior)
   bool accepted = false;         // below the uncertainty, three independent faces, not ambiguous
@@ -85,5 +96,8 @@ struct BoatRegistration {
 // than three usable planes or none of its plane triples matches the faces.
 BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& reference,
                                 const BoatRegistrationParams& params = {}, const Progress& progress = {});
+
+// The unit's cloud in the boat frame: its range scale taken out, then the transform.
+Cloud toBoatFrame(const Cloud& cloud, const RigidTransform& transform, double range_scale);
 
 }  // namespace sailshape

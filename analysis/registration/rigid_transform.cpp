@@ -144,6 +144,15 @@ Cloud transformCloud(const Cloud& cloud, const RigidTransform& t) {
   return out;
 }
 
+Cloud removeRangeScale(const Cloud& cloud, double scale) {
+  if (!(scale > 0) || !std::isfinite(scale))
+    throw InvalidInput("[removeRangeScale] scale must be finite and > 0 (got " + std::to_string(scale) + ")");
+  Cloud out = cloud;
+  const Vec3 o = cloud.viewpoint.value_or(Vec3::Zero());
+  for (Vec3& q : out.points) q = o + (q - o) / scale;
+  return out;
+}
+
 std::string formatTransform(const RigidTransform& t) {
   const Eigen::Matrix4d m = t.matrix();
   std::string out;

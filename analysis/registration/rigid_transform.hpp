@@ -48,6 +48,12 @@ double rotationDifferenceDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b)
 // The cloud with points and viewpoint mapped by `t` (other attributes kept).
 Cloud transformCloud(const Cloud& cloud, const RigidTransform& t);
 
+// The cloud with a range scale taken out (SPEC §3's systematic range error:
+// measured range = scale × true range): every point pulled towards the cloud's
+// viewpoint (the origin without one) by 1 / scale. Throws InvalidInput for a
+// scale ≤ 0 or not finite.
+Cloud removeRangeScale(const Cloud& cloud, double scale);
+
 // Four lines of four numbers, row-major, the last line 0 0 0 1; full double
 // precision. Throws FileError naming the file when it cannot be written.
 void writeTransform(const std::string& path, const RigidTransform& t);

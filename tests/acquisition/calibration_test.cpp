@@ -9,6 +9,7 @@
 #include "acquisition/sensor_model.hpp"
 #include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
+#include "analysis/registration/rigid_transform.hpp"
 
 using namespace sailshape;
 

@@ -125,6 +125,22 @@ TEST_F(RegisterCli, BoatReferenceAndDriftCheck) {
   const json doc = json::parse(readText(path("drift.json")));
   EXPECT_FALSE(doc["drift"]["moved"].get<bool>());
   EXPECT_LT(doc["drift"]["translation_m"].get<double>(), 1e-6);
+
+  // A unit whose ranges read 0.3 % long (SPEC §3's bound): the walls give the
+  // scale, --apply takes it out, and the cloud lands where the unit's points are.
+  const double k = 1.003;
+  sailshape::writeCloud(path("unit_a_long.ply"), sailshape::removeRangeScale(scene_->reference, 1 / k));
+  const Outcome longer = sailshape("register --reference " + path("unit_a_long.ply") + " --boat-reference " +
+                                   path("tunnel.json") + " --apply " + path("a_in_boat.ply") + " --json " +
+                                   path("scale.json") + " -q");
+  ASSERT_EQ(longer.exit_code, 0) << longer.err;
+  const json scaled = json::parse(readText(path("scale.json")));
+  const double fitted = scaled["boat"]["range_scale"].get<double>(), sigma = scaled["boat"]["range_scale_sigma"].get<double>();
+  EXPECT_LT(std::abs(fitted - k), 3 * sigma) << fitted << " ± " << sigma;
+  const sailshape::Cloud in_boat = sailshape::readCloud(path("a_in_boat.ply")).cloud;
+  ASSERT_EQ(in_boat.size(), scene_->reference.size());
+  for (size_t i : {size_t{0}, in_boat.size() / 2, in_boat.size() - 1})
+    EXPECT_LT((in_boat.points[i] - scene_->reference_pose * scene_->reference.points[i]).norm(), 0.002) << i;
 }
 
 TEST_F(RegisterCli, BadInputIsOneLineNamingTheProblem) {

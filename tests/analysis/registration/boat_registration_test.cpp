@@ -51,6 +51,66 @@ TEST(BoatRegistration, NoiseFreeIsExact) {
   EXPECT_LT((b.transform.translation() - s.reference_pose.translation()).norm(), 1e-4);
 }
 
+// A systematic range error (SPEC §3: up to 0.3 % of range) stretches the unit's
+// whole scene about the scanner. The chamber's floor and ceiling and its two side
+// walls, whose separations the faces give, fix the stretch; fitted with the pose,
+// it leaves the pose as right as without the error. Fitting the pose alone, each
+// wall's fit shifts by 0.3 % of its range (5-9 mm here) and the pose with them.
+TEST(BoatRegistration, OppositeWallsMeasureTheRangeScaleWithThePose) {
+  TunnelSceneParams p;
+  p.noise_sigma_m = kSigma;
+  p.reference_pose = unitPose();
+  const TunnelScene s = makeTunnelScene(p);
+  const double k = 1.003;
+  const Cloud stretched = removeRangeScale(s.reference, 1 / k);
+  const BoatRegistration b = registerToBoat(stretched, s.chamber);
+  EXPECT_TRUE(b.accepted);
+  EXPECT_LT(std::abs(b.range_scale - k), 3 * b.range_scale_sigma) << b.range_scale << " ± " << b.range_scale_sigma;
+  EXPECT_LT(b.range_scale_sigma, 0.1 * 0.003) << "measured to a tenth of the error's bound";
+  EXPECT_LT(rotationDifferenceDeg(b.transform.linear(), s.reference_pose.linear()), 0.05);
+  EXPECT_LT((b.transform.translation() - s.reference_pose.translation()).norm(), 0.002);
+  // The same cloud in the boat frame: the stretch taken out, then the pose.
+  const Cloud boat = toBoatFrame(stretched, b.transform, b.range_scale);
+  const Cloud truth = transformCloud(s.reference, s.reference_pose);
+  double worst = 0;
+  for (size_t i = 0; i < boat.size(); ++i) worst = std::max(worst, (boat.points[i] - truth.points[i]).norm());
+  EXPECT_LT(worst, 0.002);
+
+  BoatRegistrationParams rigid;
+  rigid.range_scale_prior_sigma = 0;
+  const BoatRegistration r = registerToBoat(stretched, s.chamber, rigid);
+  EXPECT_EQ(r.range_scale, 1.0);
+  EXPECT_GT((r.transform.translation() - s.reference_pose.translation()).norm(), 0.002)
+      << "without the scale the walls' shifts move the pose";
+}
+
+// Faces one of each direction (the floor, a side wall, the screen) do not fix
+// the scale: stretching the scene moves each by its range, as a translation
+// does. The prior holds the scale at 1 and its σ says it was not measured.
+TEST(BoatRegistration, OneFaceEachWayLeavesTheRangeScaleUnmeasured) {
+  TunnelSceneParams p;
+  p.noise_sigma_m = kSigma;
+  p.reference_pose = unitPose();
+  const TunnelScene s = makeTunnelScene(p);
+  BoatReference corner;
+  corner.name = "floor, wall and screen";
+  for (const ReferenceFace& f : s.chamber.faces)
+    if (f.name == "floor" || f.name == "starboard wall" || f.name == "downstream screen") corner.faces.push_back(f);
+  ASSERT_EQ(corner.faces.size(), 3u);
+  // The chamber's other walls and the cube look like this corner too: the unit's
+  // rough orientation (as a rig knows it) chooses.
+  BoatRegistrationParams bp;
+  bp.prior_rotation = unitPose().linear();
+  bp.prior_tolerance_deg = 15;
+  const BoatRegistration b = registerToBoat(s.reference, corner, bp);
+  EXPECT_TRUE(b.accepted);
+  const double prior = BoatRegistrationParams{}.range_scale_prior_sigma;
+  EXPECT_GT(b.range_scale_sigma, 0.5 * prior);
+  EXPECT_LT(std::abs(b.range_scale - 1), 0.1 * prior);
+  EXPECT_LT(rotationDifferenceDeg(b.transform.linear(), s.reference_pose.linear()), 0.05);
+  EXPECT_LT((b.transform.translation() - s.reference_pose.translation()).norm(), 0.002);
+}
+
 TEST(BoatRegistration, ACubeAloneIsAmbiguousWithoutAPrior) {
   // Deck and a cube: a quarter turn about the cube's vertical axis looks the
   // same. Without a prior the result must say ambiguous (never accepted); with
@@ -125,6 +185,9 @@ TEST(BoatRegistration, TooFewPlanesOrFacesAreClearErrors) {
   bad = {};
   bad.refine_iterations = -1;
   expectInvalidInput([&] { registerToBoat(s.reference, s.chamber, bad); }, {"registerToBoat", "refine_iterations"});
+  bad = {};
+  bad.range_scale_prior_sigma = std::nan("");
+  expectInvalidInput([&] { registerToBoat(s.reference, s.chamber, bad); }, {"registerToBoat", "range_scale_prior_sigma"});
 }
 
 TEST(BoatReferenceFile, ReadsFacesAndACube) {
