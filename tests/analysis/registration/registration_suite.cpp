@@ -2,7 +2,9 @@
 // symmetric walls, decks with a mast, partial overlap, cubes anywhere, units at
 // any orientation, noise 0–1.6 × SPEC §3's σ and systematic range errors up to
 // 0.3 %. Fresh seeds every run, printed; SAILSHAPE_REGISTRATION_SEED=<seed>
-// replays one run, SAILSHAPE_REGISTRATION_CASES=<n> changes how many cases.
+// replays one run, SAILSHAPE_REGISTRATION_CASES=<n> changes how many cases,
+// SAILSHAPE_REGISTRATION_PLY=<dir> writes each case's two clouds there
+// (case-<seed>-reference.ply, -moving.ply) for `sailshape register`.
 // A written pose must be right; a refused one needs a reason; ≥ 95 % register.
 #include <gtest/gtest.h>
 
@@ -14,6 +16,7 @@
 
 #include "analysis/core/errors.hpp"
 #include "analysis/core/units.hpp"
+#include "analysis/io/cloud_io.hpp"
 #include "analysis/registration/registration.hpp"
 #include "tests/support/room_scene.hpp"
 
@@ -56,6 +59,11 @@ TEST(RegistrationSuite, EveryWrittenPoseIsRightAndAlmostAllRegister) {
     const RoomScene& s = c.scene;
     decidable += c.decidable;
     const double diagonal = (c.params.room_max - c.params.room_min).norm();
+    if (const char* dir = std::getenv("SAILSHAPE_REGISTRATION_PLY")) {
+      const std::string stem = std::string(dir) + "/case-" + std::to_string(seed);
+      writeCloud(stem + "-reference.ply", s.reference);
+      writeCloud(stem + "-moving.ply", s.moving);
+    }
     std::string outcome;
     try {
       const Registration r = registerClouds(s.reference, s.moving);
@@ -74,6 +82,14 @@ TEST(RegistrationSuite, EveryWrittenPoseIsRightAndAlmostAllRegister) {
         ++wrong;
         decidable_wrong += c.decidable;
         outcome = std::string("WRONG POSE WRITTEN: ") + buf;
+        // What the verifier says of the truth beside the pose written: a likelier
+        // truth was never proposed or refined; a less likely one misleads the verifier.
+        const PoseVerifier verifier(s.reference, s.moving);
+        const PoseEvidence at_truth = verifier.evaluate(s.truth), written = verifier.evaluate(r.transform);
+        char why[200];
+        std::snprintf(why, sizeof why, "; log-likelihood %.1f at the truth (%zu in free space), %.1f written (%zu)",
+                      at_truth.log_likelihood, at_truth.in_free_space, written.log_likelihood, written.in_free_space);
+        outcome += why;
       } else {
         ++registered;
         decidable_registered += c.decidable;
