@@ -252,7 +252,8 @@ int main(int argc, char** argv) {
   for (size_t g = 0; g < kGroups; ++g) {
     const std::string name = g == kGroups - 1 ? "**all**" : groups[g];
     table += row(name, "sailshape", tally[g][0]);
-    table += row(name, "Open3D FPFH+RANSAC+ICP", tally[g][1]);
+    table += row(name, o3.orient_normals_to_scanner ? "Open3D, normals to the scanner" : "Open3D FPFH+RANSAC+ICP",
+                 tally[g][1]);
   }
   // Open3D's own score, to see whether a threshold on it could have refused its wrong poses.
   const auto spread = [](const std::vector<double>& v) {
