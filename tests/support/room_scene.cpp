@@ -194,3 +194,14 @@ unsigned cubeFacesSeen(const Cloud& cloud, const RigidTransform& pose, const Roo
 }
 
 }  // namespace sailshape
+
+namespace sailshape {
+
+RegistrationTolerance registrationTolerance(const RoomSceneParams& p) {
+  const double sigma_ratio = p.noise_scale;  // materials' σ ≈ 4 mm at scale 1
+  const double s = p.reference_systematic_fraction + p.moving_systematic_fraction;
+  const double diagonal_m = (p.room_max - p.room_min).norm();
+  return {0.01 + 0.04 * sigma_ratio + s / kRadPerDeg, 1e-4 + 0.0019 * sigma_ratio + s * diagonal_m};
+}
+
+}  // namespace sailshape

@@ -33,19 +33,6 @@ size_t suiteCases() {
   return 8;
 }
 
-// How far a right pose may stand from the truth. The figures: 0.01° and
-// 0.1 mm noise-free, 0.05° and 2 mm at σ = 4 mm, growing with σ in between and
-// beyond; a systematic range error s scales one unit's cloud by (1 + s), which
-// moves its points by up to s·range and turns the best fit by up to about s rad.
-struct Tolerance {
-  double rotation_deg, translation_m;
-};
-Tolerance tolerance(const RoomSceneParams& p, double scene_diagonal_m) {
-  const double sigma_ratio = p.noise_scale;  // materials' σ ≈ 4 mm at scale 1
-  const double s = p.reference_systematic_fraction + p.moving_systematic_fraction;
-  return {0.01 + 0.04 * sigma_ratio + s / kRadPerDeg, 1e-4 + 0.0019 * sigma_ratio + s * scene_diagonal_m};
-}
-
 TEST(RegistrationSuite, EveryWrittenPoseIsRightAndAlmostAllRegister) {
   const uint64_t base = suiteSeed();
   const size_t n = suiteCases();
@@ -58,7 +45,6 @@ TEST(RegistrationSuite, EveryWrittenPoseIsRightAndAlmostAllRegister) {
     const RandomCase c = randomRegistrationCase(seed);
     const RoomScene& s = c.scene;
     decidable += c.decidable;
-    const double diagonal = (c.params.room_max - c.params.room_min).norm();
     if (const char* dir = std::getenv("SAILSHAPE_REGISTRATION_PLY")) {
       const std::string stem = std::string(dir) + "/case-" + std::to_string(seed);
       writeCloud(stem + "-reference.ply", s.reference);
@@ -69,7 +55,7 @@ TEST(RegistrationSuite, EveryWrittenPoseIsRightAndAlmostAllRegister) {
       const Registration r = registerClouds(s.reference, s.moving);
       const double rot = rotationDifferenceDeg(r.rotation, s.truth.linear());
       const double tr = (r.translation - s.truth.translation()).norm();
-      const Tolerance tol = tolerance(c.params, diagonal);
+      const RegistrationTolerance tol = registrationTolerance(c.params);
       char buf[160];
       std::snprintf(buf, sizeof buf, "%.4f° %.2f mm off (tolerance %.3f° %.2f mm)", rot, 1000 * tr,
                     tol.rotation_deg, 1000 * tol.translation_m);
