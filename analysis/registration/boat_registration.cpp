@@ -224,19 +224,24 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
   double c = 1;
   Eigen::Matrix<double, 7, 7> ata_final = Eigen::Matrix<double, 7, 7>::Zero();
   double variance = 0;
+  // Each face's mean residual: what the points' own scatter cannot show (a face
+  // fitted a little off as a whole: an edge's mixed pixels, the beam's footprint).
+  double face_mean2 = 0;
+  size_t faces_used = 0, points_used = 0;
   progress("boat frame", 0.5);
   for (int it = 0; it <= p.refine_iterations; ++it) {
     const std::vector<size_t> on = facesOf(D, ref, t, 2 * tol, p.max_face_distance_m);
     Eigen::Matrix<double, 7, 7> ata = Eigen::Matrix<double, 7, 7>::Zero();
     Eigen::Matrix<double, 7, 1> atb = Eigen::Matrix<double, 7, 1>::Zero();
     out.faces.clear();
+    double face_sum2 = 0;
     double total2 = 0;
     size_t total = 0;
     for (size_t j = 0; j < D.size(); ++j) {
       if (on[j] == F.size()) continue;
       const ReferenceFace& f = F[on[j]];
       FaceMatch fm{f.name, j, D[j].points, 0, angleDeg(t.linear() * D[j].normal, f.normal)};
-      double sum2 = 0;
+      double sum2 = 0, sum1 = 0;
       for (uint32_t i : D[j].indices) {
         const Vec3& q = cloud.points[i];
         const Vec3 x = t * (v + c * (q - v));
@@ -252,10 +257,13 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
         ata += a * a.transpose();
         atb -= a * r;
         sum2 += r * r;
+        sum1 += r;
       }
       fm.rms_m = std::sqrt(sum2 / static_cast<double>(D[j].indices.size()));
       total2 += sum2;
       total += D[j].indices.size();
+      const double mean = sum1 / static_cast<double>(D[j].indices.size());
+      face_sum2 += mean * mean;
       out.faces.push_back(fm);
     }
     out.fitness_rms_m = total ? std::sqrt(total2 / static_cast<double>(total)) : 0.0;
@@ -278,6 +286,9 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
       atb(6) = 0;
     }
     ata_final = ata;
+    face_mean2 = out.faces.empty() ? 0.0 : face_sum2 / static_cast<double>(out.faces.size());
+    faces_used = out.faces.size();
+    points_used = total;
     if (it == p.refine_iterations) {
       out.accepted = true;  // provisional: constrained
       break;
@@ -292,7 +303,13 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
   }
   // k = 1/c: σ_k = σ_c / c².
   out.range_scale = 1 / c;
-  if (fit_scale && out.accepted) out.range_scale_sigma = std::sqrt(variance * ata_final.inverse()(6, 6)) / (c * c);
+  // σ of the scale: the points' scatter, and each face's offset as one
+  // observation among the faces (its points move together): a face's points
+  // carry points_used / faces_used times the weight one independent point would.
+  if (fit_scale && out.accepted) {
+    const double per_point = variance + face_mean2 * static_cast<double>(points_used) / static_cast<double>(faces_used);
+    out.range_scale_sigma = std::sqrt(per_point * ata_final.inverse()(6, 6)) / (c * c);
+  }
   progress("boat frame", 1.0);
   out.transform = t;
   out.below_uncertainty = out.fitness_rms_m <= p.uncertainty_m;

@@ -75,6 +75,8 @@ TEST(RegistrationSuite, EveryWrittenPoseIsRightAndAlmostAllRegister) {
         char why[200];
         std::snprintf(why, sizeof why, "; log-likelihood %.1f at the truth (%zu in free space), %.1f written (%zu)",
                       at_truth.log_likelihood, at_truth.in_free_space, written.log_likelihood, written.in_free_space);
+        const Vec3 e = r.translation - s.truth.translation();
+        std::snprintf(why, sizeof why, "; translation error (%.4f, %.4f, %.4f) m, reference frame", e.x(), e.y(), e.z());
         outcome += why;
       } else {
         ++registered;
