@@ -33,6 +33,14 @@ using sailshape::testing::runSailshape;
 
 namespace {
 
+// A pose stored as the database and emulator-truth.json store it: 4×4 row-major rows.
+Eigen::Isometry3d pose(const nlohmann::json& rows) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) t.matrix()(r, c) = rows.at(r).at(c).get<double>();
+  return t;
+}
+
 std::string runCommand(const std::string& cmd) {
   std::string out;
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
@@ -179,12 +187,6 @@ TEST_F(DemoRun, TheWallRegistrationStandsWhereTheEmulatorPlacedEachUnit) {
   std::ifstream in(dir_ / "out" / "emulator-truth.json");
   ASSERT_TRUE(in.good());
   const nlohmann::json truth = nlohmann::json::parse(in);
-  auto pose = [](const nlohmann::json& rows) {
-    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 4; ++c) t.matrix()(r, c) = rows.at(r).at(c).get<double>();
-    return t;
-  };
   sailshape::Database db = sailshape::openSailDatabase((dir_ / "out" / "sailshape.db").string());
   auto st = db.prepare(
       "SELECT u.serial, r.transform, s.settings FROM scans s JOIN registrations r ON r.scan_id = s.id "
@@ -297,12 +299,6 @@ TEST_F(DemoRun, AStoredScanIsReAnalysedAsItsOwnSail) {
 TEST_F(DemoRun, TheMainsCornersStandWhereTheSailFlies) {
   ASSERT_EQ(outcome_.exit_code, 0) << outcome_.err;
   const sailshape::SailSurface truth(sailshape::scaleDesign(sailshape::exampleDesign(sailshape::SailType::Main), 1.0 / 3.6));
-  auto pose = [](const nlohmann::json& rows) {
-    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 4; ++c) t.matrix()(r, c) = rows.at(r).at(c).get<double>();
-    return t;
-  };
   Eigen::Isometry3d true_pose = Eigen::Isometry3d::Identity();
   {
     std::ifstream in(dir_ / "out" / "emulator-truth.json");
