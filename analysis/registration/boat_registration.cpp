@@ -222,18 +222,14 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
   const bool fit_scale = p.range_scale_prior_sigma > 0;
   const Vec3 v = cloud.viewpoint.value_or(Vec3::Zero());
   double c = 1;
-  Eigen::Matrix<double, 7, 7> ata_final = Eigen::Matrix<double, 7, 7>::Zero();
-  double variance = 0;
-  // Each face's mean residual: what the points' own scatter cannot show (a face
-  // fitted a little off as a whole: an edge's mixed pixels, the beam's footprint).
-  double face_mean2 = 0;
-  size_t faces_used = 0, points_used = 0;
   progress("boat frame", 0.5);
   for (int it = 0; it <= p.refine_iterations; ++it) {
     const std::vector<size_t> on = facesOf(D, ref, t, 2 * tol, p.max_face_distance_m);
     Eigen::Matrix<double, 7, 7> ata = Eigen::Matrix<double, 7, 7>::Zero();
     Eigen::Matrix<double, 7, 1> atb = Eigen::Matrix<double, 7, 1>::Zero();
     out.faces.clear();
+    // Σ of each face's mean residual squared: what the points' own scatter cannot
+    // show (a face fitted a little off as a whole: an edge's mixed pixels, the beam's footprint).
     double face_sum2 = 0;
     double total2 = 0;
     size_t total = 0;
@@ -267,7 +263,7 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
       out.faces.push_back(fm);
     }
     out.fitness_rms_m = total ? std::sqrt(total2 / static_cast<double>(total)) : 0.0;
-    variance = total > 7 ? total2 / static_cast<double>(total - 7) : 0.0;
+    const double variance = total > 7 ? total2 / static_cast<double>(total - 7) : 0.0;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(ata.topLeftCorner<6, 6>());
     const bool constrained = total > 0 && es.eigenvalues()(0) >= 1e-9 * es.eigenvalues()(5);
     if (!constrained) {
@@ -285,12 +281,16 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
       ata(6, 6) = 1;
       atb(6) = 0;
     }
-    ata_final = ata;
-    face_mean2 = out.faces.empty() ? 0.0 : face_sum2 / static_cast<double>(out.faces.size());
-    faces_used = out.faces.size();
-    points_used = total;
     if (it == p.refine_iterations) {
       out.accepted = true;  // provisional: constrained
+      // σ of k = 1/c (σ_k = σ_c / c²): the points' scatter, and each face's offset
+      // as one observation among the faces (its points move together): a face's
+      // points carry total / faces times the weight one independent point would.
+      if (fit_scale) {
+        const double faces = static_cast<double>(out.faces.size());
+        const double per_point = variance + face_sum2 / faces * static_cast<double>(total) / faces;
+        out.range_scale_sigma = std::sqrt(per_point * ata.inverse()(6, 6)) / (c * c);
+      }
       break;
     }
     const Eigen::Matrix<double, 7, 1> x = ata.ldlt().solve(atb);
@@ -301,15 +301,7 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
     t = step * t;
     c += x(6);
   }
-  // k = 1/c: σ_k = σ_c / c².
   out.range_scale = 1 / c;
-  // σ of the scale: the points' scatter, and each face's offset as one
-  // observation among the faces (its points move together): a face's points
-  // carry points_used / faces_used times the weight one independent point would.
-  if (fit_scale && out.accepted) {
-    const double per_point = variance + face_mean2 * static_cast<double>(points_used) / static_cast<double>(faces_used);
-    out.range_scale_sigma = std::sqrt(per_point * ata_final.inverse()(6, 6)) / (c * c);
-  }
   progress("boat frame", 1.0);
   out.transform = t;
   out.below_uncertainty = out.fitness_rms_m <= p.uncertainty_m;
