@@ -19,7 +19,7 @@
 namespace sailshape::outline_internal {
 namespace {
 
-enum class Stop { Edge, Grazing, Range, Shadow };
+using Stop = SailOutline::Coverage::Stop;
 
 struct BoundaryStop {
   Stop stop = Stop::Edge;
@@ -42,13 +42,16 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
   // The next sample out lies a boundary spacing further; ranges carry up to 0.3 % of
   // systematic error (SPEC §3).
   const double range_margin = 2.0 * loop.spacing + 0.003 * p.scanner_max_range_m + 2.0 * p.scanner_position_sigma_m;
-  // The beams' angular spacing: the boundary's sample spacing over its range. The
-  // scene's samples stand on the same grid of directions, so a beam just beyond the
-  // boundary that met something nearer has a scene sample within a cell or two of it.
+  // The beams' angular spacing: the boundary's sample spacing over its range, and
+  // at least the coarser step of the scan's angular grid (along its lines or between
+  // them). The scene's samples stand on that grid, so a beam just beyond the boundary
+  // that met something nearer has a scene sample within a cell or two of it; cells
+  // narrower than the grid's coarser step leave directions between its samples
+  // empty, read as beams that met nothing.
   std::vector<double> angular;
   for (size_t i = 0; i < n; ++i) angular.push_back(loop.spacing / std::max(1e-9, (loop.points[i] - scanner).norm()));
   std::nth_element(angular.begin(), angular.begin() + static_cast<long>(n / 2), angular.end());
-  const double cell = std::max(1e-5, angular[n / 2]);
+  const double cell = std::max({1e-5, angular[n / 2], angularGridStep(scene, scanner)});
   const DirectionMap seen(scene, scanner, cell);
   // The scene less the mesh's own samples and those beside them (three spacings): a
   // return among these at the sail's range, beyond its boundary, is more sail the mesh
@@ -116,6 +119,25 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
   return stops;
 }
 
+// Why the samples stop, in words: `value` is the nearest thing in the way's range
+// (Shadow, m), the farthest range (Range, m) or the widest incidence (Grazing, °).
+std::string stopReason(Stop stop, double value, const OutlineParams& p) {
+  switch (stop) {
+    case Stop::Shadow:
+      return "the samples stop at the shadow of something " + formatFixed(value, 1) +
+             " m from the scanner, between it and the sail";
+    case Stop::Range:
+      return "the samples stop " + formatFixed(value, 1) + " m from the scanner, at the end of its " +
+             formatFixed(p.scanner_max_range_m, 0) + " m range";
+    case Stop::Grazing:
+      return "the samples stop where the beams meet the cloth at up to " + formatFixed(value, 0) +
+             "° incidence (beyond " + formatFixed(p.grazing_incidence_deg, 0) +
+             "° the cloth returns less and less, and nothing at grazing angles)";
+    case Stop::Edge: break;
+  }
+  return "the samples stop at the sail's edge";
+}
+
 double edgeFraction(const std::vector<BoundaryStop>& stops, const std::vector<size_t>& idx) {
   if (idx.empty()) return 0;
   size_t edge = 0;
@@ -147,15 +169,10 @@ std::optional<std::string> notReached(const BoundaryLoop& loop, const std::vecto
       farthest_m = std::max(farthest_m, stops[i].range_m);
     }
     if (2 * (grazing + range + shadow) <= count) continue;
-    const std::string at = std::string("the ") + name + ": the samples stop ";
-    if (shadow >= grazing && shadow >= range)
-      return at + "at the shadow of something " + formatFixed(shadow_m, 1) +
-             " m from the scanner, between it and the sail";
-    if (range >= grazing)
-      return at + formatFixed(farthest_m, 1) + " m from the scanner, at the end of its " +
-             formatFixed(p.scanner_max_range_m, 0) + " m range";
-    return at + "where the beams meet the cloth at up to " + formatFixed(widest_deg, 0) + "° incidence (beyond " +
-           formatFixed(p.grazing_incidence_deg, 0) + "° the cloth returns less and less, and nothing at grazing angles)";
+    const std::string at = std::string("the ") + name + ": ";
+    if (shadow >= grazing && shadow >= range) return at + stopReason(Stop::Shadow, shadow_m, p);
+    if (range >= grazing) return at + stopReason(Stop::Range, farthest_m, p);
+    return at + stopReason(Stop::Grazing, widest_deg, p);
   }
   return std::nullopt;
 }
@@ -169,6 +186,7 @@ SailOutline::Coverage scanCoverage(const BoundaryLoop& loop, const NamedCorners&
   // A corner's neighbourhood: the stretch of boundary its turn is measured over.
   const double around = std::max(5.0 * loop.spacing, 0.02 * loop.total);
   const std::vector<BoundaryStop> stops = stopsAlongLoop(loop, samples, scanner, scene, around, p);
+  for (const BoundaryStop& s : stops) cov.boundary_stop.push_back(s.stop);
   cov.luff = edgeFraction(stops, indicesBetween(loop, c, c.tack, c.head));
   cov.foot = edgeFraction(stops, indicesBetween(loop, c, c.tack, c.clew));
   cov.leech = edgeFraction(stops, indicesBetween(loop, c, c.clew, c.has_peak ? c.peak : c.head));
@@ -187,3 +205,27 @@ SailOutline::Coverage scanCoverage(const BoundaryLoop& loop, const NamedCorners&
 }
 
 }  // namespace sailshape::outline_internal
+
+namespace sailshape {
+
+std::optional<std::string> SailOutline::Coverage::shortOfEdgeNear(const std::vector<Vec3>& boundary,
+                                                                  const Vec3& point) const {
+  const size_t n = boundary.size();
+  if (!known || boundary_stop.size() != n || n == 0) return std::nullopt;
+  size_t nearest = 0;
+  for (size_t i = 1; i < n; ++i)
+    if ((boundary[i] - point).squaredNorm() < (boundary[nearest] - point).squaredNorm()) nearest = i;
+  size_t counts[4] = {0, 0, 0, 0};
+  for (long k = -5; k <= 5; ++k) {
+    const size_t i = (nearest + n + static_cast<size_t>(k + static_cast<long>(n))) % n;
+    ++counts[static_cast<size_t>(boundary_stop[i])];
+  }
+  const size_t short_of_edge = counts[1] + counts[2] + counts[3];
+  if (2 * short_of_edge <= counts[0] + short_of_edge) return std::nullopt;
+  if (counts[3] >= counts[1] && counts[3] >= counts[2])
+    return std::string("the samples stop at the shadow of something between the scanner and the sail");
+  if (counts[2] >= counts[1]) return std::string("the samples stop at the end of the scanner's range");
+  return std::string("the samples stop where the beams meet the cloth at grazing incidence");
+}
+
+}  // namespace sailshape

@@ -2,6 +2,7 @@
 // The sail's outline on its mesh (SPEC §4 step 6): boundary = edges used by one
 // triangle; corners = the 3 (or 4 for square-top sails) boundary points with the
 // sharpest turning; luff, leech, foot (and top) are the boundary between them.
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -106,7 +107,15 @@ struct SailOutline {
     double luff = 1, leech = 1, foot = 1, top = 1;
     // Why a corner was not reached, one sentence per corner ("the head: ..."); empty when all were.
     std::vector<std::string> unreached;
+    // Why the samples stop at each point of SailOutline::boundary (same order); empty
+    // when coverage is not known.
+    enum class Stop : uint8_t { Edge, Grazing, Range, Shadow };
+    std::vector<Stop> boundary_stop;
     bool allCornersReached() const { return tack && clew && head && peak; }
+    // Where the boundary point nearest `point` and the five each side of it along the
+    // boundary mostly stop short of the sail's edge (grazing, range, shadow): why, as
+    // "the samples stop ..."; nothing where they stop at the edge or coverage is not known.
+    std::optional<std::string> shortOfEdgeNear(const std::vector<Vec3>& boundary, const Vec3& point) const;
   } coverage;
   std::vector<std::string> warnings;
 };

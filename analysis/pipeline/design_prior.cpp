@@ -323,7 +323,11 @@ SailAnalysis analyzeWithDesign(const Cloud& scan, const RegionBox& region, const
   setTwistRelative(cut.sections);
 
   SailAnalysis a = std::move(partial);
-  if (have_measured) o.coverage = measured.coverage;
+  if (have_measured) {
+    o.coverage = measured.coverage;
+    // Its stops follow the scan's boundary, not the fitted design's.
+    o.coverage.boundary_stop.clear();
+  }
   if (!have_measured) o.coverage.unreached = {"where the scan reached the sail's edges: " + why};
   o.coverage.known = true;  // as far as the scan and the design tell it
   o.coverage.tack = reached[0];

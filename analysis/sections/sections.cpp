@@ -768,6 +768,12 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
   s.plane_normal = f.m;
   s.luff_point = f.L;
   s.leech_point = f.R;
+  // A chord's end where the samples stop short of the sail's edge (grazing, range, a
+  // shadow) is where the scan stopped, not the luff or leech: the chord, and every
+  // value along it, would be short by however much of the sail was not seen.
+  for (const auto& [end, name] : {std::pair<const Vec3*, const char*>{&f.L, "luff"}, {&f.R, "leech"}})
+    if (auto why = g.outline.coverage.shortOfEdgeNear(g.outline.boundary, *end))
+      throw AnalysisError("[cutSections] its " + std::string(name) + " end is not the sail's edge: " + *why);
   const auto xy = toChordCoords(cut, f);
   s.curve_samples = xy.size();
   for (const Bridge& b : cut.bridges) s.bridged_pct += 100.0 * (b.x1 - b.x0) / f.chord;
