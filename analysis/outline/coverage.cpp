@@ -20,6 +20,7 @@ namespace sailshape::outline_internal {
 namespace {
 
 using Stop = SailOutline::Coverage::Stop;
+constexpr size_t kStopKinds = 5;
 
 struct BoundaryStop {
   Stop stop = Stop::Edge;
@@ -99,7 +100,20 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
       return other < to.norm() + 10.0 * loop.spacing ? Beam::Sail : Beam::Clear;
     };
     double met = 0;
-    if (probe(2.0 * loop.spacing, met) != Beam::Blocked) continue;
+    const Beam first = probe(2.0 * loop.spacing, met);
+    if (first != Beam::Blocked) {
+      // More of the scene lies where the sail would go on, at its range: the sail's own
+      // samples the surface left out (too sparse or too noisy to mesh), when they go on
+      // for half a metre (beyond a spar's or a stay's width) or sixteen spacings. From
+      // four spacings out: the scene's samples within three of the mesh are its own.
+      bool goes_on = true;
+      const double reach = std::max(16.0 * loop.spacing, 0.5);
+      for (double w = 4.0 * loop.spacing; goes_on && w <= 2.0 * reach; w *= 2.0)
+        goes_on = probe(std::min(w, reach), met) == Beam::Sail;
+      if (goes_on) s.stop = Stop::LeftOut;
+      continue;
+    }
+    if (first != Beam::Blocked) continue;
     // A narrow shadow (a stay, a mast seen beside a sail's head) that ends within the
     // corner's neighbourhood, beyond which the beams meet neither anything nearer nor
     // more of the scene off the mesh where the sail would go on (a strip of it cut off
@@ -133,6 +147,8 @@ std::string stopReason(Stop stop, double value, const OutlineParams& p) {
       return "the samples stop where the beams meet the cloth at up to " + formatFixed(value, 0) +
              "° incidence (beyond " + formatFixed(p.grazing_incidence_deg, 0) +
              "° the cloth returns less and less, and nothing at grazing angles)";
+    case Stop::LeftOut:
+      return "the sail's samples go on beyond the surface built from them (too sparse or too noisy there to mesh)";
     case Stop::Edge: break;
   }
   return "the samples stop at the sail's edge";
@@ -145,6 +161,18 @@ double edgeFraction(const std::vector<BoundaryStop>& stops, const std::vector<si
   return static_cast<double>(edge) / static_cast<double>(idx.size());
 }
 
+// The stop that most of `count` boundary points short of the sail's edge share (by
+// counts per Stop), or Edge when at most half of them are short of it. Shadow first,
+// then range, grazing and left out on ties: the more specific reason.
+Stop mostlyShortOfEdge(const size_t (&counts)[kStopKinds], size_t count) {
+  const size_t edge = counts[static_cast<size_t>(Stop::Edge)];
+  if (2 * (count - edge) <= count) return Stop::Edge;
+  Stop most = Stop::Shadow;
+  for (Stop k : {Stop::Range, Stop::Grazing, Stop::LeftOut})
+    if (counts[static_cast<size_t>(k)] > counts[static_cast<size_t>(most)]) most = k;
+  return most;
+}
+
 // Whether the samples reach the corner at loop index c: the boundary within `around`
 // of it, on each side, is mostly where the sail ends. When not, the reason.
 std::optional<std::string> notReached(const BoundaryLoop& loop, const std::vector<BoundaryStop>& stops, size_t c,
@@ -152,27 +180,22 @@ std::optional<std::string> notReached(const BoundaryLoop& loop, const std::vecto
   const size_t n = loop.size();
   bracket_m = 0;
   for (size_t dir : {size_t{1}, n - 1}) {
-    size_t grazing = 0, range = 0, shadow = 0, count = 0;
+    size_t counts[kStopKinds] = {}, count = 0;
     double widest_deg = 0, farthest_m = 0, shadow_m = 0;
     for (size_t i = c, walked = 0; walked <= n / 2; i = (i + dir) % n, ++walked) {
       const double arc = std::abs(loop.cum[i] - loop.cum[c]);
       if (std::min(arc, loop.total - arc) > around) break;
       ++count;
-      grazing += stops[i].stop == Stop::Grazing;
-      range += stops[i].stop == Stop::Range;
-      if (stops[i].stop == Stop::Shadow) {
-        ++shadow;
-        shadow_m = std::max(shadow_m, stops[i].shadow_range_m);
-      }
+      ++counts[static_cast<size_t>(stops[i].stop)];
+      if (stops[i].stop == Stop::Shadow) shadow_m = std::max(shadow_m, stops[i].shadow_range_m);
       widest_deg = std::max(widest_deg, stops[i].incidence_deg);
       bracket_m = std::max(bracket_m, stops[i].bracket_m);
       farthest_m = std::max(farthest_m, stops[i].range_m);
     }
-    if (2 * (grazing + range + shadow) <= count) continue;
-    const std::string at = std::string("the ") + name + ": ";
-    if (shadow >= grazing && shadow >= range) return at + stopReason(Stop::Shadow, shadow_m, p);
-    if (range >= grazing) return at + stopReason(Stop::Range, farthest_m, p);
-    return at + stopReason(Stop::Grazing, widest_deg, p);
+    const Stop most = mostlyShortOfEdge(counts, count);
+    if (most == Stop::Edge) continue;
+    const double value = most == Stop::Shadow ? shadow_m : most == Stop::Range ? farthest_m : widest_deg;
+    return std::string("the ") + name + ": " + stopReason(most, value, p);
   }
   return std::nullopt;
 }
@@ -210,22 +233,25 @@ namespace sailshape {
 
 std::optional<std::string> SailOutline::Coverage::shortOfEdgeNear(const std::vector<Vec3>& boundary,
                                                                   const Vec3& point) const {
+  using namespace outline_internal;
   const size_t n = boundary.size();
   if (!known || boundary_stop.size() != n || n == 0) return std::nullopt;
   size_t nearest = 0;
   for (size_t i = 1; i < n; ++i)
     if ((boundary[i] - point).squaredNorm() < (boundary[nearest] - point).squaredNorm()) nearest = i;
-  size_t counts[4] = {0, 0, 0, 0};
+  size_t counts[kStopKinds] = {};
   for (long k = -5; k <= 5; ++k) {
     const size_t i = (nearest + n + static_cast<size_t>(k + static_cast<long>(n))) % n;
     ++counts[static_cast<size_t>(boundary_stop[i])];
   }
-  const size_t short_of_edge = counts[1] + counts[2] + counts[3];
-  if (2 * short_of_edge <= counts[0] + short_of_edge) return std::nullopt;
-  if (counts[3] >= counts[1] && counts[3] >= counts[2])
-    return std::string("the samples stop at the shadow of something between the scanner and the sail");
-  if (counts[2] >= counts[1]) return std::string("the samples stop at the end of the scanner's range");
-  return std::string("the samples stop where the beams meet the cloth at grazing incidence");
+  switch (mostlyShortOfEdge(counts, 11)) {
+    case Stop::Shadow: return std::string("the samples stop at the shadow of something between the scanner and the sail");
+    case Stop::Range: return std::string("the samples stop at the end of the scanner's range");
+    case Stop::Grazing: return std::string("the samples stop where the beams meet the cloth at grazing incidence");
+    case Stop::LeftOut: return stopReason(Stop::LeftOut, 0, OutlineParams{});
+    case Stop::Edge: break;
+  }
+  return std::nullopt;
 }
 
 }  // namespace sailshape

@@ -108,12 +108,13 @@ struct SailOutline {
     // Why a corner was not reached, one sentence per corner ("the head: ..."); empty when all were.
     std::vector<std::string> unreached;
     // Why the samples stop at each point of SailOutline::boundary (same order); empty
-    // when coverage is not known.
-    enum class Stop : uint8_t { Edge, Grazing, Range, Shadow };
+    // when coverage is not known. LeftOut: they do not; more of the sail's samples lie
+    // beyond, left out of the surface.
+    enum class Stop : uint8_t { Edge, Grazing, Range, Shadow, LeftOut };
     std::vector<Stop> boundary_stop;
     bool allCornersReached() const { return tack && clew && head && peak; }
     // Where the boundary point nearest `point` and the five each side of it along the
-    // boundary mostly stop short of the sail's edge (grazing, range, shadow): why, as
+    // boundary mostly stop short of the sail's edge (grazing, range, shadow, left out): why, as
     // "the samples stop ..."; nothing where they stop at the edge or coverage is not known.
     std::optional<std::string> shortOfEdgeNear(const std::vector<Vec3>& boundary, const Vec3& point) const;
   } coverage;

@@ -414,6 +414,40 @@ TEST(SailOutline, AShadowSampledOnACoarseAngularGridIsStillAShadow) {
       << o.coverage.unreached[0];
 }
 
+// A surface built from part of the samples only (the sparse top left out of the mesh):
+// the scene still holds the sail's samples above it, at its range, going on for metres.
+// That boundary is not the sail's edge, and the head is not reached. A mast along the
+// luff (a 10 cm tube just forward of it, at the sail's range) is not more sail: the
+// beams beyond it meet nothing within half a metre, and every corner is reached.
+TEST(SailOutline, SamplesLeftOutOfTheSurfaceAreNoEdge) {
+  const Vec3 scanner(-1.5, -8, 5);
+  const Mesh full = flatTriangle(kTack, kClew, kHead, 120);
+  // Only the samples below 7 m as its vertices, as a surface built from them holds.
+  Mesh lower;
+  std::vector<uint32_t> renumber(full.vertices.size());
+  for (size_t v = 0; v < full.vertices.size(); ++v)
+    if (full.vertices[v].z() < 7.0) {
+      renumber[v] = static_cast<uint32_t>(lower.vertices.size());
+      lower.vertices.push_back(full.vertices[v]);
+    }
+  for (const auto& t : full.triangles)
+    if (full.vertices[t[0]].z() < 7.0 && full.vertices[t[1]].z() < 7.0 && full.vertices[t[2]].z() < 7.0)
+      lower.triangles.push_back({renumber[t[0]], renumber[t[1]], renumber[t[2]]});
+  std::vector<Vec3> scene = full.vertices;
+  const SailOutline o = extractOutline(lower, {}, {}, 0, scanner, scene);
+  EXPECT_FALSE(o.coverage.head);
+  EXPECT_TRUE(o.coverage.tack && o.coverage.clew);
+  ASSERT_FALSE(o.coverage.unreached.empty());
+  EXPECT_EQ(o.coverage.unreached[0].rfind("the head: the sail's samples go on beyond the surface built from them", 0), 0u)
+      << o.coverage.unreached[0];
+  // The whole main with a mast: a tube of radius 5 cm whose aft side touches the luff.
+  const Vec3 up = (kHead - kTack).normalized();
+  for (double h = -0.5; h <= 10.6; h += 0.02)
+    for (double a = 0; a < 2 * M_PI; a += M_PI / 16)
+      scene.push_back(kTack + h * up + Vec3(0.05 + 0.05 * std::cos(a), 0.05 * std::sin(a), 0));
+  EXPECT_TRUE(extractOutline(full, {}, {}, 0, scanner, scene).coverage.allCornersReached());
+}
+
 TEST(SailOutline, AClosedSurfaceHasNoBoundary) {
   Mesh m;
   m.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
