@@ -113,7 +113,6 @@ std::vector<BoundaryStop> stopsAlongLoop(const BoundaryLoop& loop, const Samples
       if (goes_on) s.stop = Stop::LeftOut;
       continue;
     }
-    if (first != Beam::Blocked) continue;
     // A narrow shadow (a stay, a mast seen beside a sail's head) that ends within the
     // corner's neighbourhood, beyond which the beams meet neither anything nearer nor
     // more of the scene off the mesh where the sail would go on (a strip of it cut off

@@ -58,6 +58,13 @@ std::vector<size_t> facesOf(const std::vector<DetectedPlane>& planes, const Boat
   return face;
 }
 
+// Whether normal equations over (rotation, translation, scale) fix all six degrees of
+// freedom of the pose: the pose block's smallest eigenvalue not vanishing beside its largest.
+bool fixesThePose(const Eigen::Matrix<double, 7, 7>& ata) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(ata.topLeftCorner<6, 6>());
+  return es.eigenvalues()(0) >= 1e-9 * es.eigenvalues()(5);
+}
+
 }  // namespace
 
 std::vector<ReferenceFace> cubeFaces(const std::string& name, const Vec3& centre, double size_m, double yaw_deg) {
@@ -269,8 +276,7 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
     }
     out.fitness_rms_m = total ? std::sqrt(total2 / static_cast<double>(total)) : 0.0;
     const double variance = total > 7 ? total2 / static_cast<double>(total - 7) : 0.0;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(ata.topLeftCorner<6, 6>());
-    const bool constrained = total > 0 && es.eigenvalues()(0) >= 1e-9 * es.eigenvalues()(5);
+    const bool constrained = total > 0 && fixesThePose(ata);
     if (!constrained) {
       out.warnings.push_back("the matched faces do not fix all six degrees of freedom; the transform comes from the "
                              "plane intersection alone");
@@ -299,8 +305,7 @@ BoatRegistration registerToBoat(const Cloud& cloud, const BoatReference& ref, co
         std::vector<double> left_out;
         for (size_t f = 0; f < face_ata.size(); ++f) {
           const Eigen::Matrix<double, 7, 7> a = ata - face_ata[f];
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> rest(a.topLeftCorner<6, 6>());
-          if (rest.eigenvalues()(0) < 1e-9 * rest.eigenvalues()(5)) continue;
+          if (!fixesThePose(a)) continue;
           left_out.push_back(a.ldlt().solve(atb - face_atb[f])(6));
         }
         double jack_var = 0;

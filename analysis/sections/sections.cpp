@@ -769,7 +769,7 @@ Section measureSection(double t, const Mesh& mesh, const SectionParams& p, const
   s.luff_point = f.L;
   s.leech_point = f.R;
   // A chord's end where the samples stop short of the sail's edge (grazing, range, a
-  // shadow) is where the scan stopped, not the luff or leech: the chord, and every
+  // shadow, samples left out of the surface) is where the scan stopped, not the luff or leech: the chord, and every
   // value along it, would be short by however much of the sail was not seen.
   for (const auto& [end, name] : {std::pair<const Vec3*, const char*>{&f.L, "luff"}, {&f.R, "leech"}})
     if (auto why = g.outline.coverage.shortOfEdgeNear(g.outline.boundary, *end))
